@@ -1,0 +1,1 @@
+"""The synthetic benchmark: procedural buildings, ground truth, cameras, renderer, scene I/O."""

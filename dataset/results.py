@@ -1,0 +1,121 @@
+"""The result file every method writes: one JSON per (scene, method, protocol) (DESIGN.md).
+
+Methods (``baselines``, ``neural3d``) write these; ``metrics.compare`` reads
+only these and the scenes' ground truth.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from dataclasses import asdict, dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from dataset.atomic import write_json_atomic
+
+RESULT_SCHEMA_VERSION = 1
+
+
+@dataclass(frozen=True)
+class FacadeEstimate:
+    """A method's figures for one facade; ``missing`` + ``reason`` when it had no usable view."""
+
+    id: int
+    wwr: float | None
+    window_area_m2: float | None = None
+    facade_area_m2: float | None = None
+    width_m: float | None = None
+    height_m: float | None = None
+    views_used: int = 0
+    missing: bool = False
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class MethodResult:
+    """A method's estimate for one building under one protocol.
+
+    ``footprint`` is a GeoJSON Polygon in world x/y metres, or ``None`` for
+    methods that do not estimate one. ``config`` is the method's full config;
+    ``code_version`` the git commit (or package version) that produced it.
+    """
+
+    scene: str
+    method: str  # "2D-S" | "2D-SS" | "neural3d" | a variant name
+    protocol: str  # "ideal" | "multi" | "train"
+    wwr: float | None
+    window_area_m2: float | None
+    facade_area_m2: float | None
+    facades: tuple[FacadeEstimate, ...] = ()
+    footprint: dict[str, Any] | None = None
+    config: dict[str, Any] = field(default_factory=dict)
+    code_version: str = ""
+    wall_time_s: float = 0.0
+    warnings: tuple[str, ...] = ()
+    schema_version: int = RESULT_SCHEMA_VERSION
+
+    def to_json_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["facades"] = [asdict(f) for f in self.facades]
+        d["warnings"] = list(self.warnings)
+        return d
+
+    @staticmethod
+    def from_json_dict(d: dict[str, Any]) -> MethodResult:
+        return MethodResult(
+            **{
+                **d,
+                "facades": tuple(FacadeEstimate(**f) for f in d.get("facades", ())),
+                "warnings": tuple(d.get("warnings", ())),
+            }
+        )
+
+
+def result_filename(scene: str, method: str, protocol: str) -> str:
+    """File name of a result, e.g. ``tiny_skyscraper_0__2D-SS__ideal.json``."""
+    return f"{scene}__{method}__{protocol}.json"
+
+
+def write_result(folder: str | Path, result: MethodResult) -> Path:
+    """Write ``result`` atomically into ``folder``; returns the file path."""
+    path = Path(folder) / result_filename(result.scene, result.method, result.protocol)
+    write_json_atomic(path, result.to_json_dict())
+    return path
+
+
+def read_result(path: str | Path) -> MethodResult:
+    """Read a result file.
+
+    Raises
+    ------
+    ValueError
+        If the file is missing, not JSON, or not a result of this schema.
+    """
+    path = Path(path)
+    try:
+        return MethodResult.from_json_dict(json.loads(path.read_text()))
+    except FileNotFoundError as exc:
+        raise ValueError(f"result file {path} does not exist") from exc
+    except (json.JSONDecodeError, TypeError, KeyError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path} is not a valid result file: {exc}") from exc
+
+
+@cache
+def code_version() -> str:
+    """The git commit of the code (with ``-dirty`` for local changes), or the package version."""
+    here = Path(__file__).resolve().parent.parent
+    try:
+        out = subprocess.run(
+            ["git", "describe", "--always", "--dirty", "--abbrev=12"],
+            cwd=here, capture_output=True, text=True, timeout=5, check=True,
+        )
+        return out.stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            return "envelope-bench " + version("envelope-bench")
+        except PackageNotFoundError:
+            return "unknown"

@@ -1,0 +1,105 @@
+"""Exact ground truth of one building: ``building.json`` (DESIGN.md).
+
+Areas follow one convention everywhere: a window's (or door's) area is its
+opening in the facade plane; the reveal (the shallow recess around it) is not
+facade area. Gross facade area = wall + window + door; WWR comes from
+:func:`metrics.wwr.window_to_wall_ratio`, the project's one definition.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from dataset.atomic import write_json_atomic
+
+BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
+BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
+
+
+@dataclass(frozen=True)
+class FacadeTruth:
+    """One facade: a wall plane (or a curved wall) facing one way.
+
+    ``normal`` is the outward unit vector in the world frame (for a curved
+    facade, the mean outward direction); ``width_m`` is measured along the wall
+    (arc length for a curved one).
+    """
+
+    id: int
+    normal: tuple[float, float, float]
+    width_m: float
+    height_m: float
+    window_area_m2: float
+    wall_area_m2: float
+    door_area_m2: float
+    facade_area_m2: float
+    wwr: float
+    curved: bool = False
+
+
+@dataclass(frozen=True)
+class BuildingTruth:
+    """Whole-building ground truth; areas in m², lengths in m, world x/y for the footprint."""
+
+    id: str
+    type: BuildingType
+    floors: int
+    height_m: float
+    window_area_m2: float
+    facade_area_m2: float
+    wall_area_m2: float
+    door_area_m2: float
+    wwr: float
+    footprint: dict[str, Any]  # GeoJSON Polygon, world x/y metres
+    footprint_area_m2: float
+    facades: tuple[FacadeTruth, ...]
+    name: str = ""
+    seed: int | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def facade(self, facade_id: int) -> FacadeTruth:
+        """The facade with id ``facade_id``."""
+        for f in self.facades:
+            if f.id == facade_id:
+                return f
+        raise KeyError(f"building {self.id} has no facade {facade_id}")
+
+    def to_json_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["facades"] = [asdict(f) for f in self.facades]
+        for f in d["facades"]:
+            f["normal"] = list(f["normal"])
+        return d
+
+    @staticmethod
+    def from_json_dict(d: dict[str, Any]) -> BuildingTruth:
+        facades = tuple(
+            FacadeTruth(**{**f, "normal": tuple(float(x) for x in f["normal"])})
+            for f in d["facades"]
+        )
+        return BuildingTruth(**{**d, "facades": facades})
+
+
+def write_building(path: str | Path, truth: BuildingTruth) -> None:
+    """Write ``building.json`` atomically (deterministic bytes for equal input)."""
+    write_json_atomic(path, truth.to_json_dict())
+
+
+def read_building(path: str | Path) -> BuildingTruth:
+    """Read ``building.json``.
+
+    Raises
+    ------
+    ValueError
+        If the file is missing or lacks a field of DESIGN.md's schema.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"ground truth file {path} does not exist")
+    try:
+        return BuildingTruth.from_json_dict(json.loads(path.read_text()))
+    except (json.JSONDecodeError, TypeError, KeyError) as exc:
+        raise ValueError(f"{path} is not a valid building.json: {exc}") from exc

@@ -1,0 +1,1 @@
+"""The paper's figures, made only from files that metrics/ and dataset/ wrote."""

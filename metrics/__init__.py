@@ -1,0 +1,1 @@
+"""Error measures, comparison tables and plots."""

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs everything envelope-bench needs into the current Python environment.
+# Idempotent: a second run installs nothing. The CPU build of PyTorch goes in first,
+# because an unpinned `torch` requirement would pull several GB of CUDA packages.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=${PYTHON:-python3}
+export PIP_ROOT_USER_ACTION=ignore PIP_DISABLE_PIP_VERSION_CHECK=1
+if ! "$PY" -c "import torch" >/dev/null 2>&1; then
+    echo "setup: installing the CPU build of PyTorch (torch==2.13.0)"
+    "$PY" -m pip install --quiet torch==2.13.0
+fi
+"$PY" -m pip install --quiet --disable-pip-version-check -e ".[test]"
+"$PY" -c "import torch, trimesh, embreex, kornia, cv2, skimage, shapely" \
+    || { echo "setup: a dependency failed to import; see the messages above" >&2; exit 1; }
+echo "setup: done ($("$PY" -c 'import torch; print("torch", torch.__version__)'))"
