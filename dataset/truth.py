@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from dataset.atomic import write_json_atomic
+from dataset.mesh import LabelledMesh
 
 BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
 BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
@@ -81,6 +82,14 @@ class BuildingTruth:
             for f in d["facades"]
         )
         return BuildingTruth(**{**d, "facades": facades})
+
+
+@dataclass(frozen=True)
+class Building:
+    """A building as the generator (or the importer) makes it: labelled mesh + exact truth."""
+
+    mesh: LabelledMesh
+    truth: BuildingTruth
 
 
 def write_building(path: str | Path, truth: BuildingTruth) -> None:

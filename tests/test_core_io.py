@@ -152,3 +152,21 @@ def test_result_file_round_trip(tmp_path):
     path.write_text("{not json")
     with pytest.raises(ValueError, match="not a valid result"):
         read_result(path)
+
+
+def test_footprint_geojson_round_trip():
+    from shapely.geometry import Polygon
+
+    from dataset.footprint import geojson_to_polygon, polygon_to_geojson
+
+    ring = [(0, 0), (0, 4), (3, 4), (3, 0)]  # clockwise on purpose
+    hole = [(1, 1), (2, 1), (2, 2), (1, 2)]
+    poly = Polygon(ring, [hole])
+    geo = polygon_to_geojson(poly)
+    assert geo["type"] == "Polygon"
+    back = geojson_to_polygon(geo)
+    assert back.area == pytest.approx(11.0)
+    assert back.symmetric_difference(poly).area < 1e-12
+    assert Polygon(geo["coordinates"][0]).exterior.is_ccw
+    with pytest.raises(ValueError, match="GeoJSON Polygon"):
+        geojson_to_polygon({"type": "Point", "coordinates": [0, 0]})
