@@ -1,0 +1,103 @@
+"""Walls + other faces -> :class:`dataset.truth.Building` with analytic ground truth.
+
+Per-facade truth is summed from each wall's parameters (outline area, opening
+sizes, contact rectangles), never from the triangulated mesh, so that tests can
+hold one against the other.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from shapely.geometry import Polygon
+
+from dataset.facade_geometry import WallSpec, wall_faces
+from dataset.footprint import polygon_to_geojson
+from dataset.polygon_mesh import PlanarFace, triangulate_faces
+from dataset.truth import Building, BuildingTruth, BuildingType, FacadeTruth
+from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+
+
+def facade_truths(
+    walls: list[WallSpec], curved_facade_ids: frozenset[int] = frozenset()
+) -> tuple[FacadeTruth, ...]:
+    """Truth of every facade (walls grouped by facade id, sorted by id).
+
+    Width is the summed wall length (the length along the facets of a curved facade),
+    height the highest wall point, normal the length-weighted mean outward normal.
+    """
+    ids = sorted({w.facade_id for w in walls})
+    if ids != list(range(1, len(ids) + 1)):
+        raise ValueError(f"facade ids must be 1..n without gaps, got {ids}")
+    out = []
+    for fid in ids:
+        group = [w for w in walls if w.facade_id == fid]
+        window = sum(w.opening_area_m2("window") for w in group)
+        door = sum(w.opening_area_m2("door") for w in group)
+        wall = sum(w.wall_area_m2() for w in group)
+        gross = gross_facade_area_m2(wall, window, door)
+        normal = sum(w.frame.length_m * w.frame.normal for w in group)
+        normal = normal / np.linalg.norm(normal)
+        out.append(
+            FacadeTruth(
+                id=fid,
+                normal=tuple(round(float(x), 12) + 0.0 for x in normal),
+                width_m=float(sum(w.frame.length_m for w in group)),
+                height_m=max(w.height_m for w in group),
+                window_area_m2=float(window),
+                wall_area_m2=float(wall),
+                door_area_m2=float(door),
+                facade_area_m2=gross,
+                wwr=window_to_wall_ratio(window, gross),
+                curved=fid in curved_facade_ids,
+            )
+        )
+    return tuple(out)
+
+
+def assemble_building(
+    *,
+    building_id: str,
+    building_type: BuildingType,
+    seed: int | None,
+    floors: int,
+    height_m: float,
+    footprint_xy: np.ndarray,
+    walls: list[WallSpec],
+    other_faces: list[PlanarFace],
+    curved_facade_ids: frozenset[int] = frozenset(),
+    name: str = "",
+    extra: dict[str, Any] | None = None,
+) -> Building:
+    """Triangulate walls (with openings) and the other faces; attach the analytic truth.
+
+    ``footprint_xy`` is the (n, 2) ground outline in world x/y metres.
+    """
+    if floors < 1:
+        raise ValueError(f"a building needs floors >= 1, got {floors}")
+    facades = facade_truths(walls, curved_facade_ids)
+    window = sum(f.window_area_m2 for f in facades)
+    door = sum(f.door_area_m2 for f in facades)
+    wall = sum(f.wall_area_m2 for f in facades)
+    gross = gross_facade_area_m2(wall, window, door)
+    footprint = Polygon(footprint_xy)
+    truth = BuildingTruth(
+        id=building_id,
+        type=building_type,
+        floors=int(floors),
+        height_m=float(height_m),
+        window_area_m2=float(window),
+        facade_area_m2=gross,
+        wall_area_m2=float(wall),
+        door_area_m2=float(door),
+        wwr=window_to_wall_ratio(window, gross),
+        footprint=polygon_to_geojson(footprint),
+        footprint_area_m2=float(footprint.area),
+        facades=facades,
+        name=name,
+        seed=seed,
+        extra=extra or {},
+    )
+    faces = [face for w in walls for face in wall_faces(w)] + list(other_faces)
+    return Building(mesh=triangulate_faces(faces), truth=truth)
