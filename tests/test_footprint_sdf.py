@@ -1,0 +1,85 @@
+"""neural3d.footprint: zero contour of analytic SDFs on a horizontal plane."""
+
+import numpy as np
+import pytest
+from sdf_shapes import box_sdf, cylinder_sdf, l_prism_sdf
+from shapely.geometry import MultiPolygon, Point, Polygon
+from shapely.geometry import box as rectangle
+
+from dataset.footprint import geojson_to_polygon, polygon_to_geojson
+from neural3d.footprint import footprint_from_sdf
+
+SCENE_LO, SCENE_HI = np.array([-2.0, -2.0, -1.0]), np.array([14.0, 14.0, 10.0])
+
+
+def _iou(a, b) -> float:
+    return a.intersection(b).area / a.union(b).area
+
+
+def _footprint(sdf, **kwargs):
+    args = {"height_m": 0.5, "cell_m": 0.1, "min_area_m2": 1.0, **kwargs}
+    return footprint_from_sdf(sdf, SCENE_LO, SCENE_HI, **args)
+
+
+def test_l_prism_footprint():
+    truth = rectangle(0, 0, 10, 4).union(rectangle(0, 0, 4, 12))
+    poly = _footprint(l_prism_sdf)
+    assert isinstance(poly, Polygon) and poly.is_valid
+    assert _iou(poly, truth) >= 0.99
+    assert poly.area == pytest.approx(72.0, rel=0.01)
+    # the GeoJSON round trip the extract CLI writes
+    assert _iou(geojson_to_polygon(polygon_to_geojson(poly)), poly) == pytest.approx(1, abs=1e-9)
+
+
+def test_circle_area_and_cell_size():
+    coarse = _footprint(lambda p: cylinder_sdf(p, [6, 6], 5.0, 0, 8), cell_m=0.5)
+    fine = _footprint(lambda p: cylinder_sdf(p, [6, 6], 5.0, 0, 8), cell_m=0.05)
+    circle = Point(6, 6).buffer(5.0, 256)
+    # linear interpolation between samples cuts the convex curve: always a little inside
+    assert fine.area <= np.pi * 25 and fine.area == pytest.approx(np.pi * 25, rel=1e-3)
+    assert _iou(fine, circle) > _iou(coarse, circle) > 0.99
+
+
+def test_courtyard_is_a_hole():
+    def sdf(p):  # 12 x 12 m block with a 4 x 4 m courtyard cut out
+        return np.maximum(box_sdf(p, [0, 0, 0], [12, 12, 8]), -box_sdf(p, [4, 4, -1], [8, 8, 9]))
+
+    poly = _footprint(sdf)
+    assert isinstance(poly, Polygon) and len(poly.interiors) == 1
+    assert Polygon(poly.interiors[0]).area == pytest.approx(16.0, rel=0.01)
+    assert poly.area == pytest.approx(144 - 16, rel=0.01)
+    # a hole below min_area_m2 is filled
+    assert len(_footprint(sdf, min_area_m2=20.0).interiors) == 0
+
+
+def test_separate_pieces_and_slivers():
+    def sdf(p):
+        return np.minimum.reduce([box_sdf(p, [0, 0, 0], [4, 4, 8]),
+                                  box_sdf(p, [8, 8, 0], [12, 12, 8]),
+                                  box_sdf(p, [10, 0, 0], [10.5, 0.5, 8])])  # 0.25 m² piece
+
+    poly = _footprint(sdf)
+    assert isinstance(poly, MultiPolygon) and len(poly.geoms) == 2
+    assert poly.area == pytest.approx(32.0, rel=0.01)
+    assert len(_footprint(sdf, min_area_m2=0.1).geoms) == 3
+
+
+def test_plane_that_misses_the_building():
+    with pytest.raises(ValueError, match="misses the building"):
+        _footprint(l_prism_sdf, height_m=9.0)  # above the 8 m roof
+    with pytest.raises(ValueError, match="outside the box"):
+        _footprint(l_prism_sdf, height_m=12.0)
+    with pytest.raises(ValueError, match="wholly inside"):
+        _footprint(lambda p: np.full(len(p), -1.0))
+    with pytest.raises(ValueError, match="no footprint piece"):
+        _footprint(l_prism_sdf, min_area_m2=100.0)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"cell_m": 0.0}, "cell_m"),
+    ({"cell_m": 1e-3}, "too large"),
+    ({"min_area_m2": -1.0}, "min_area_m2"),
+])
+def test_bad_arguments(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        _footprint(l_prism_sdf, **kwargs)

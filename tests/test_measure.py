@@ -1,0 +1,119 @@
+"""neural3d.measure: class areas, WWR and facade grouping on meshes of analytic shapes."""
+
+import numpy as np
+import pytest
+from sdf_shapes import banded_labels, box_sdf, cylinder_sdf, l_prism_sdf
+
+from dataset.classes import SemanticClass
+from neural3d.measure import (
+    MeasureConfig,
+    class_area_m2,
+    group_facade_faces,
+    measure_semantic_mesh,
+)
+from neural3d.meshing import extract_mesh, label_vertices
+
+WALL, WINDOW, ROOF = int(SemanticClass.WALL), int(SemanticClass.WINDOW), int(SemanticClass.ROOF)
+
+
+def _semantic_mesh(sdf, lo, hi, band_z_m, voxel_size_m):
+    v, f = extract_mesh(sdf, lo, hi, voxel_size_m=voxel_size_m)
+    return v, f, label_vertices(v, banded_labels(sdf, band_z_m))
+
+
+@pytest.fixture(scope="module")
+def banded_box():
+    """6 x 4 x 10 m box, window band 3 m < z < 6 m on every side: WWR = 3 / 10."""
+    def sdf(p):
+        return box_sdf(p, [-3, -2, 0], [3, 2, 10])
+
+    return _semantic_mesh(sdf, [-4, -3, -1], [4, 3, 11], (3.0, 6.0), 0.08)
+
+
+def test_triangle_area_is_shared_by_vertex_classes():
+    v = np.array([[0, 0, 0], [2, 0, 0], [0, 3, 0], [0, 0, 1.0]])
+    f = np.array([[0, 1, 2], [0, 1, 3]])
+    areas = class_area_m2(v, f, np.array([WINDOW, WINDOW, WALL, ROOF]))
+    np.testing.assert_allclose(areas[0, [WINDOW, WALL]], [3 * 2 / 3, 3 * 1 / 3])
+    np.testing.assert_allclose(areas[1, [WINDOW, ROOF]], [1 * 2 / 3, 1 * 1 / 3])
+    np.testing.assert_allclose(areas.sum(axis=1), [3.0, 1.0])
+
+
+def test_box_with_window_band(banded_box):
+    m = measure_semantic_mesh(*banded_box)
+    assert m.facade_area_m2 == pytest.approx(2 * (6 + 4) * 10, rel=0.01)
+    assert m.window_area_m2 == pytest.approx(2 * (6 + 4) * 3, rel=0.01)
+    assert m.wwr == pytest.approx(0.3, abs=0.01)
+    assert m.facade_area_m2 == pytest.approx(m.wall_area_m2 + m.window_area_m2 + m.door_area_m2)
+    assert [round(f.azimuth_deg) % 360 for f in m.facades] == [0, 90, 180, 270]
+    for facade, width in zip(m.facades, (4, 6, 4, 6)):
+        assert facade.wwr == pytest.approx(0.3, abs=0.01)
+        assert facade.width_m == pytest.approx(width, abs=0.2)  # two voxels
+        assert facade.height_m == pytest.approx(10, abs=0.2)
+        # the cut vertical edges (one voxel wide) go to one neighbour or the other
+        assert facade.facade_area_m2 == pytest.approx(width * 10, abs=10 * 2 * 0.08)
+    np.testing.assert_allclose([f.offset_m for f in m.facades], [3, 2, 3, 2], atol=0.05)
+
+
+def test_cylinder_curved_facade():
+    def sdf(p):
+        return cylinder_sdf(p, [1.0, -1.0], 5.0, 0.0, 10.0)
+
+    v, f, labels = _semantic_mesh(sdf, [-5, -7, -1], [7, 5, 11], (2.0, 5.0), 0.1)
+    m = measure_semantic_mesh(v, f, labels)
+    assert m.facade_area_m2 == pytest.approx(2 * np.pi * 5 * 10, rel=0.01)
+    assert m.wwr == pytest.approx(0.3, abs=0.01)
+    # no straight wall: greedy peaks are >= 30 degrees apart and leave no gap of 60, so the
+    # curve is cut into segments 30 to 60 degrees wide
+    assert 360 / 60 < len(m.facades) <= 360 / 30
+    assert sum(fa.facade_area_m2 for fa in m.facades) == pytest.approx(m.facade_area_m2, rel=0.01)
+
+
+def test_l_prism_splits_parallel_walls():
+    v, f, labels = _semantic_mesh(l_prism_sdf, [-1, -1, -1], [11, 13, 9], (2.0, 4.0), 0.1)
+    m = measure_semantic_mesh(v, f, labels)
+    # six walls: two face +x (x = 4 and x = 10) and two +y (y = 4 and y = 12)
+    got = sorted((round(fa.azimuth_deg) % 360, round(fa.offset_m)) for fa in m.facades)
+    assert got == [(0, 4), (0, 10), (90, 4), (90, 12), (180, 0), (270, 0)]
+    assert m.wwr == pytest.approx(2 / 8, abs=0.01)
+
+
+def test_grouping_config_and_ungrouped_area(banded_box):
+    v, f, labels = banded_box
+    group = group_facade_faces(v, f, labels)
+    assert group.shape == (len(f),) and set(np.unique(group)) == {-1, 0, 1, 2, 3}
+    # the roof is no facade: only facade-class triangles may be grouped
+    roof_only = (labels[f] == ROOF).all(axis=1)
+    assert (group[roof_only] == -1).all()
+    strict = measure_semantic_mesh(v, f, labels, config=MeasureConfig(min_facade_area_m2=50.0))
+    assert len(strict.facades) == 2  # only the 6 m wide (60 m²) facades stay
+    assert strict.ungrouped_facade_area_m2 == pytest.approx(80, rel=0.02)
+    grouped = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
+        count="grouped", min_facade_area_m2=50.0))
+    assert grouped.facade_area_m2 == pytest.approx(sum(fa.facade_area_m2 for fa in strict.facades))
+
+
+def test_mesh_without_facade_classes_has_no_wwr():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+    m = measure_semantic_mesh(v, [[0, 1, 2]], np.full(3, ROOF))
+    assert m.wwr is None and m.facade_area_m2 == 0 and m.facades == ()
+
+
+@pytest.mark.parametrize("labels, faces, message", [
+    (np.zeros(2), [[0, 1, 2]], "vertex_labels must have shape"),
+    (np.full(3, 9), [[0, 1, 2]], "class ids outside"),
+    (np.zeros(3), [[0, 1, 3]], "do not exist"),
+    (np.zeros(3), [[0, 1]], r"shape \(F, 3\)"),
+])
+def test_bad_inputs(labels, faces, message):
+    with pytest.raises(ValueError, match=message):
+        measure_semantic_mesh(np.zeros((3, 3)), faces, labels)
+
+
+@pytest.mark.parametrize("kwargs", [
+    {"count": "some"}, {"facade_max_tilt_deg": 90.0}, {"azimuth_bin_deg": 0.0},
+    {"min_facade_separation_deg": 0.0}, {"plane_gap_m": -1.0},
+])
+def test_bad_config(kwargs):
+    with pytest.raises(ValueError, match=next(iter(kwargs))):
+        MeasureConfig(**kwargs)
