@@ -1,0 +1,54 @@
+"""The built-in default benchmark of ``python -m metrics.compare``, made once into a cache."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+DEFAULT_CACHE = Path(".cache/envelope-bench")
+
+
+@dataclass(frozen=True)
+class DefaultBenchmark:
+    """The preset, image size and views of the default run, chosen to fit ~10 minutes on 2 cores.
+
+    ``root / preset`` is the benchmark folder (relative to the working folder).
+    """
+
+    preset: str = "tiny"
+    root: Path = DEFAULT_CACHE
+    resolution: int = 128
+    views: int = 40
+    expected_minutes: float = 10.0
+
+    @property
+    def folder(self) -> Path:
+        return self.root / self.preset
+
+    def announce(self, methods: tuple[str, ...], neural3d_minutes: float) -> str:
+        """The line printed before the default run starts."""
+        made = "cached" if self.folder.is_dir() else "to be generated"
+        return (
+            f"Built-in default: the '{self.preset}' benchmark ({made} in {self.folder}, "
+            f"{self.resolution} px, {self.views} orbit views), methods {', '.join(methods)}"
+            + (f", neural3d {neural3d_minutes:g} min per building" if "neural3d" in methods
+               else "")
+            + f". This takes up to about {self.expected_minutes:g} minutes on 2 CPU cores."
+        )
+
+
+def ensure_benchmark(benchmark: DefaultBenchmark) -> Path:
+    """Generate the benchmark if absent (the generator resumes and skips finished scenes).
+
+    Raises
+    ------
+    ValueError
+        If the generator is not available or fails.
+    """
+    try:
+        from dataset.generate import GenerateConfig, generate_preset
+    except ImportError as exc:
+        raise ValueError(f"cannot make the default benchmark: {exc}") from exc
+    config = GenerateConfig(resolution=benchmark.resolution, views=benchmark.views)
+    generate_preset(benchmark.preset, benchmark.folder, config, workers=1)
+    return benchmark.folder

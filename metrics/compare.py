@@ -1,0 +1,307 @@
+"""``python -m metrics.compare``: run what is missing, then print and write Tables 2 and 3.
+
+With no arguments it runs the built-in default (the ``tiny`` benchmark, made
+into a cache folder on first use, every method, both view protocols, neural3d
+for a short CPU budget). With ``--data`` it compares on a benchmark or a
+user's scenes. Outputs (``--out``): the tables as CSV, Markdown and LaTeX,
+per-building and per-facade CSVs, plots (PNG + PDF), ``provenance.json``, the
+estimated footprints, the 2D-SS pipeline images of one facade and
+``neural3d_runs.json`` pointing at neural3d's meshes: everything ``figures.make`` reads.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+
+from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.results import code_version
+from dataset.truth import BuildingTruth, read_building
+from metrics.aggregate import aggregate_by_family
+from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark, ensure_benchmark
+from metrics.errors import BuildingErrors, FacadeErrors, building_errors, facade_errors
+from metrics.errors import failed_building as failed_row
+from metrics.methods import (
+    METHODS,
+    VIEW_PROTOCOLS,
+    Neural3dBudget,
+    debug_images_2dss,
+    method_specs,
+    neural3d_run_dir,
+)
+from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.report import (
+    per_building_table,
+    per_facade_table,
+    table2_errors,
+    table3_footprint_iou,
+)
+from metrics.runner import MethodSpec, Outcome, find_scenes, run_missing
+from metrics.tables import Table, to_csv, to_text, write_table
+
+PROVENANCE_FILE = "provenance.json"
+NEURAL3D_POINTERS_FILE = "neural3d_runs.json"
+PIPELINE_FOLDER = "2dss_pipeline"
+FOOTPRINTS_FOLDER = "footprints"
+PLOTS_FOLDER = "plots"
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """What one comparison produced: per-building and per-facade rows and the two tables."""
+
+    rows: tuple[BuildingErrors, ...]
+    facade_rows: tuple[FacadeErrors, ...]
+    table2: Table
+    table3: Table
+    outcomes: tuple[Outcome, ...]
+
+
+def compare(
+    data: Path,
+    specs: Sequence[MethodSpec],
+    results_dir: Path,
+    out_dir: Path,
+    *,
+    allow_run: bool = True,
+    command: str = "python -m metrics.compare",
+) -> Comparison:
+    """Run what is missing, evaluate every result against the truth and write all outputs.
+
+    Raises
+    ------
+    ValueError
+        If ``data`` holds no scene folder.
+    """
+    scene_dirs = find_scenes(data)
+    outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run)
+    truths = {d.name: _read_truth(d) for d in scene_dirs}
+    rows, facade_rows = evaluate(outcomes, truths)
+    groups = aggregate_by_family(rows)
+    footprint_methods = {s.name for s in specs if s.has_footprint}
+    comparison = Comparison(
+        rows=tuple(rows),
+        facade_rows=tuple(facade_rows),
+        table2=table2_errors(groups),
+        table3=table3_footprint_iou(groups, footprint_methods),
+        outcomes=tuple(outcomes),
+    )
+    provenance = _provenance(data, results_dir, specs, outcomes, command)
+    comment = (
+        f"produced by `{command}` (envelope-bench {provenance['code_version']}) "
+        f"from {provenance['data']} at {provenance['created_utc']}; "
+        f"methods: {', '.join(s.name for s in specs)}; details in {PROVENANCE_FILE}"
+    )
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for table in (comparison.table2, comparison.table3):
+        write_table(table, out_dir, comment)
+    for table in (per_building_table(rows), per_facade_table(facade_rows)):
+        write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
+    _write_plots(groups, rows, out_dir / PLOTS_FOLDER)
+    _write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
+    _write_neural3d_pointers(scene_dirs, results_dir, out_dir)
+    if allow_run and any(s.name == "2D-SS" for s in specs):
+        _keep_pipeline_images(scene_dirs, specs, out_dir / PIPELINE_FOLDER)
+    write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
+    return comparison
+
+
+def evaluate(
+    outcomes: Sequence[Outcome], truths: dict[str, BuildingTruth | None]
+) -> tuple[list[BuildingErrors], list[FacadeErrors]]:
+    """Per-building and per-facade rows of every outcome (failed outcomes as failed rows)."""
+    rows: list[BuildingErrors] = []
+    facade_rows: list[FacadeErrors] = []
+    for o in outcomes:
+        truth = truths.get(o.scene)
+        family = truth.type if truth is not None else "unknown"
+        if o.result is None:
+            rows.append(failed_row(o.scene, family, o.method, o.protocol, o.reason))
+            continue
+        rows.append(building_errors(o.result, truth))
+        facade_rows.extend(facade_errors(o.result, truth))
+    return rows, facade_rows
+
+
+def _read_truth(scene_dir: Path) -> BuildingTruth | None:
+    path = scene_dir / "building.json"
+    if not path.is_file():
+        return None
+    try:
+        return read_building(path)
+    except ValueError as exc:
+        print(f"warning: {exc}; {scene_dir.name} is compared without ground truth",
+              file=sys.stderr)
+        return None
+
+
+def _provenance(
+    data: Path, results_dir: Path, specs: Sequence[MethodSpec], outcomes: Sequence[Outcome],
+    command: str,
+) -> dict:
+    return {
+        "produced_by": command,
+        "code_version": code_version(),
+        "created_utc": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "data": str(data.resolve()),
+        "results": str(results_dir.resolve()),
+        "methods": {s.name: {"protocols": list(s.protocols), "config": s.config} for s in specs},
+        "runs": [
+            {
+                "scene": o.scene, "method": o.method, "protocol": o.protocol,
+                "status": o.status, "reason": o.reason,
+                "result_file": str(o.path) if o.path else None,
+                "result_code_version": o.result.code_version if o.result else None,
+                "wall_time_s": o.result.wall_time_s if o.result else None,
+            }
+            for o in outcomes
+        ],
+    }
+
+
+def _write_plots(groups, rows, folder: Path) -> None:
+    for plot, data, stem in (
+        (plot_errors_by_family, groups, "errors_by_family"),
+        (plot_wwr_scatter, rows, "wwr_scatter"),
+        (plot_iou_per_building, rows, "iou_per_building"),
+    ):
+        try:
+            plot(data, folder / stem)
+        except ValueError as exc:
+            print(f"plot {stem} skipped: {exc}", file=sys.stderr)
+
+
+def _write_footprints(outcomes: Sequence[Outcome], folder: Path) -> None:
+    for o in outcomes:
+        if o.result is not None and o.result.footprint is not None:
+            write_json_atomic(folder / f"{o.scene}__{o.method}__{o.protocol}.geojson",
+                              o.result.footprint)
+
+
+def _write_neural3d_pointers(scene_dirs: Sequence[Path], results_dir: Path, out: Path) -> None:
+    runs = []
+    for scene_dir in scene_dirs:
+        run_dir = neural3d_run_dir(results_dir, scene_dir.name)
+        if (run_dir / "mesh.ply").is_file():
+            footprint = run_dir / "footprint.geojson"
+            runs.append({
+                "scene": scene_dir.name,
+                "run_dir": str(run_dir.resolve()),
+                "mesh": str((run_dir / "mesh.ply").resolve()),
+                "footprint": str(footprint.resolve()) if footprint.is_file() else None,
+            })
+    write_json_atomic(out / NEURAL3D_POINTERS_FILE, {"runs": runs})
+
+
+def _keep_pipeline_images(
+    scene_dirs: Sequence[Path], specs: Sequence[MethodSpec], folder: Path
+) -> None:
+    """Keep the 2D-SS debug images of one facade (the first view of the first scene's facade 1)."""
+    if folder.is_dir() and any(folder.glob("*.png")):
+        return
+    protocol = next(s for s in specs if s.name == "2D-SS").protocols[0]
+    for scene_dir in scene_dirs:
+        if not (scene_dir / "transforms.json").is_file():
+            continue
+        tmp = folder.with_name(f".{folder.name}.tmp")
+        shutil.rmtree(tmp, ignore_errors=True)
+        try:
+            debug_images_2dss(scene_dir, protocol, tmp)
+        except Exception as exc:  # the figure is optional; the comparison is not
+            print(f"2D-SS pipeline images skipped: {type(exc).__name__}: {exc}", file=sys.stderr)
+            shutil.rmtree(tmp, ignore_errors=True)
+            return
+        images = sorted(tmp.glob("*.png"))
+        if images:
+            # One facade: the images sharing the first file's <scene>__<protocol>__f<id>__v<k> stem.
+            stem = images[0].name.rsplit("__", 1)[0]
+            folder.mkdir(parents=True, exist_ok=True)
+            for image in images:
+                if image.name.startswith(stem + "__"):
+                    shutil.copy2(image, folder / image.name)
+        shutil.rmtree(tmp, ignore_errors=True)
+        return
+
+
+def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog="python -m metrics.compare",
+        description=(
+            "Compare WWR / window / facade-area and footprint estimates of 2D-S, 2D-SS and "
+            "neural3d against ground truth, running only the results that are missing. "
+            "Without --data it runs the built-in default: the tiny benchmark (generated into "
+            f"{DEFAULT_CACHE}), all methods, about 10 minutes on 2 CPU cores. Prints Table 2 "
+            "(errors per family) and Table 3 (footprint IoU) and writes them as CSV, Markdown "
+            "and LaTeX with plots and provenance.json into --out."
+        ),
+    )
+    parser.add_argument("--data", type=Path, help="a scene folder or a folder of scene folders "
+                        "(default: the built-in tiny benchmark)")
+    parser.add_argument("--methods", default=",".join(METHODS),
+                        help=f"comma-separated methods (default: {','.join(METHODS)})")
+    parser.add_argument("--views", default=",".join(VIEW_PROTOCOLS),
+                        help="comma-separated view protocols of the 2D methods "
+                        "(default: ideal,multi); neural3d always uses its train views")
+    parser.add_argument("--results", type=Path,
+                        help="folder of result JSONs to read and fill (default: <data>-results)")
+    parser.add_argument("--out", type=Path,
+                        help="folder for tables, plots, provenance (default: <data>-compare)")
+    parser.add_argument("--neural3d-minutes", type=float, default=Neural3dBudget.minutes,
+                        help="training time limit per building for neural3d, minutes "
+                        f"(default: {Neural3dBudget.minutes})")
+    parser.add_argument("--neural3d-preset", default=Neural3dBudget.preset,
+                        choices=("paper", "fast", "tiny"), help="neural3d training preset")
+    parser.add_argument("--device", default="cpu",
+                        help="torch device for neural3d: cpu or cuda (default: cpu)")
+    parser.add_argument("--no-run", action="store_true",
+                        help="only read existing result files; never run a method")
+    return parser.parse_args(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = _parse_args(argv)
+    try:
+        start = time.perf_counter()
+        methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
+        views = tuple(v.strip() for v in args.views.split(",") if v.strip())
+        _check_device(args.device)
+        budget = Neural3dBudget(args.neural3d_preset, args.neural3d_minutes, args.device)
+        data = args.data
+        if data is None:
+            default = DefaultBenchmark()
+            print(default.announce(methods, budget.minutes), flush=True)
+            data = ensure_benchmark(default)
+        results = args.results or data.with_name(f"{data.name}-results")
+        out = args.out or data.with_name(f"{data.name}-compare")
+        specs = method_specs(methods, views, results, neural3d=budget)
+        argv_text = " ".join(sys.argv[1:] if argv is None else argv)
+        comparison = compare(data, specs, results, out, allow_run=not args.no_run,
+                             command=f"python -m metrics.compare {argv_text}".strip())
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted: finished results are kept; run again to continue", file=sys.stderr)
+        return 130
+    print()
+    print(to_text(comparison.table2))
+    print(to_text(comparison.table3))
+    print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
+          f"(results in {results}); {time.perf_counter() - start:.0f} s")
+    return 0
+
+
+def _check_device(device: str) -> None:
+    if device not in ("cpu", "cuda") and not device.startswith("cuda:"):
+        raise ValueError(f"unknown device {device!r}; use cpu or cuda")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+

@@ -1,0 +1,217 @@
+"""Error measures of one method's estimate against the exact ground truth.
+
+The paper's error is the absolute percentage error, ``100 * |est - true| / true``,
+applied to the WWR (the paper's "mean absolute percentage error" once averaged),
+to the window area ("window" error) and to the gross facade area ("wall" error).
+Footprints are compared by intersection over union of their polygons.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import shapely
+from shapely.geometry import MultiPolygon, Polygon
+from shapely.ops import unary_union
+
+from dataset.footprint import geojson_to_polygon
+from dataset.results import MethodResult
+from dataset.truth import BuildingTruth
+
+Status = Literal["ok", "failed"]
+NO_TRUTH_FAMILY = "unknown"  # family of a scene without building.json (a user's photos)
+FACADE_PROTOCOLS = ("ideal", "multi")  # protocols whose facade ids are the truth's ids
+
+
+def absolute_percentage_error(estimate: float, truth: float) -> float:
+    """Absolute percentage error ``100 * |estimate - truth| / truth`` (in %).
+
+    Raises
+    ------
+    ValueError
+        If ``truth`` is not positive or either value is not finite.
+    """
+    if not (math.isfinite(estimate) and math.isfinite(truth)):
+        raise ValueError(f"estimate {estimate} and truth {truth} must both be finite numbers")
+    if truth <= 0:
+        raise ValueError(
+            f"the percentage error needs a positive true value, got {truth}; "
+            "a building without windows has no WWR percentage error"
+        )
+    return 100.0 * abs(float(estimate) - float(truth)) / float(truth)
+
+
+def footprint_iou(a: Polygon | MultiPolygon, b: Polygon | MultiPolygon) -> float:
+    """Intersection over union of two footprint polygons (same frame and units), in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        If either polygon has no area (an empty union has no IoU).
+    """
+    checked = []
+    for name, poly in (("first", a), ("second", b)):
+        if not isinstance(poly, Polygon | MultiPolygon):
+            raise ValueError(f"{name} footprint must be a shapely (Multi)Polygon, got {type(poly)}")
+        poly = _valid(poly)
+        if poly.is_empty or poly.area <= 0:
+            raise ValueError(f"{name} footprint has no area; cannot compute an IoU")
+        checked.append(poly)
+    a, b = checked
+    union = a.union(b).area
+    return float(a.intersection(b).area / union)
+
+
+@dataclass(frozen=True)
+class BuildingErrors:
+    """One (scene, method, protocol): estimates, truth and errors (APE in %, IoU in [0, 1]).
+
+    ``status`` is ``"failed"`` when the method produced no WWR (``reason`` says why);
+    error fields are ``None`` where the method or the truth lacks the figure.
+    """
+
+    scene: str
+    family: str
+    method: str
+    protocol: str
+    status: Status = "ok"
+    reason: str = ""
+    wwr_est: float | None = None
+    wwr_true: float | None = None
+    wwr_ape: float | None = None
+    window_est_m2: float | None = None
+    window_true_m2: float | None = None
+    window_ape: float | None = None
+    facade_est_m2: float | None = None
+    facade_true_m2: float | None = None
+    facade_ape: float | None = None
+    footprint_iou: float | None = None
+    wall_time_s: float | None = None
+
+
+@dataclass(frozen=True)
+class FacadeErrors:
+    """One facade of one (scene, method, protocol); APE in %, ``None`` where not estimated."""
+
+    scene: str
+    family: str
+    method: str
+    protocol: str
+    facade_id: int
+    status: Status = "ok"
+    reason: str = ""
+    wwr_est: float | None = None
+    wwr_true: float | None = None
+    wwr_ape: float | None = None
+    window_ape: float | None = None
+    facade_ape: float | None = None
+
+
+def failed_building(
+    scene: str, family: str, method: str, protocol: str, reason: str
+) -> BuildingErrors:
+    """The row of a run that produced no usable result (crash, corrupt file, no views)."""
+    return BuildingErrors(scene, family, method, protocol, status="failed", reason=reason)
+
+
+def building_errors(result: MethodResult, truth: BuildingTruth | None) -> BuildingErrors:
+    """Errors of one result against its building's truth (``None``: estimates only).
+
+    A result without a WWR counts as failed, with its warnings as the reason.
+    A footprint that cannot be compared (malformed GeoJSON) gives IoU ``None``
+    and a reason, but does not fail the WWR figures.
+    """
+    family = truth.type if truth is not None else NO_TRUTH_FAMILY
+    if result.wwr is None or not math.isfinite(result.wwr):
+        reason = "; ".join(result.warnings) or "the method produced no WWR"
+        return failed_building(result.scene, family, result.method, result.protocol, reason)
+    reasons: list[str] = []
+    iou = None
+    if result.footprint is not None and truth is not None:
+        try:
+            iou = footprint_iou(
+                geojson_to_polygon(result.footprint), geojson_to_polygon(truth.footprint)
+            )
+        except ValueError as exc:
+            reasons.append(f"footprint: {exc}")
+    t = truth
+    wwr_ape = _ape_or_none(result.wwr, t.wwr if t else None, reasons, "WWR")
+    window_ape = _ape_or_none(
+        result.window_area_m2, t.window_area_m2 if t else None, reasons, "window"
+    )
+    facade_ape = _ape_or_none(
+        result.facade_area_m2, t.facade_area_m2 if t else None, reasons, "facade"
+    )
+    return BuildingErrors(
+        scene=result.scene,
+        family=family,
+        method=result.method,
+        protocol=result.protocol,
+        reason="; ".join(reasons),
+        wwr_est=result.wwr,
+        wwr_true=t.wwr if t else None,
+        wwr_ape=wwr_ape,
+        window_est_m2=result.window_area_m2,
+        window_true_m2=t.window_area_m2 if t else None,
+        window_ape=window_ape,
+        facade_est_m2=result.facade_area_m2,
+        facade_true_m2=t.facade_area_m2 if t else None,
+        facade_ape=facade_ape,
+        footprint_iou=iou,
+        wall_time_s=result.wall_time_s,
+    )
+
+
+def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[FacadeErrors, ...]:
+    """Per-facade errors, for protocols whose facade ids are the truth's (ideal, multi).
+
+    Other protocols (neural3d's ``train``) number facades their own way, so
+    their facades cannot be matched to the truth and give no rows.
+    """
+    if truth is None or result.protocol not in FACADE_PROTOCOLS:
+        return ()
+    true_by_id = {f.id: f for f in truth.facades}
+    rows = []
+    for est in result.facades:
+        true = true_by_id.get(est.id)
+        base = (result.scene, truth.type, result.method, result.protocol, est.id)
+        if true is None:
+            rows.append(FacadeErrors(*base, status="failed", reason="no such facade in the truth"))
+        elif est.missing or est.wwr is None:
+            rows.append(FacadeErrors(*base, status="failed", reason=est.reason or "missing"))
+        else:
+            notes: list[str] = []
+            wwr_ape = _ape_or_none(est.wwr, true.wwr, notes, "WWR")
+            window_ape = _ape_or_none(est.window_area_m2, true.window_area_m2, notes, "window")
+            facade_ape = _ape_or_none(est.facade_area_m2, true.facade_area_m2, notes, "facade")
+            rows.append(FacadeErrors(
+                *base, reason="; ".join(notes), wwr_est=est.wwr, wwr_true=true.wwr,
+                wwr_ape=wwr_ape, window_ape=window_ape, facade_ape=facade_ape,
+            ))
+    return tuple(rows)
+
+
+def _ape_or_none(
+    estimate: float | None, truth: float | None, reasons: list[str], what: str
+) -> float | None:
+    if estimate is None or truth is None:
+        return None
+    try:
+        return absolute_percentage_error(estimate, truth)
+    except ValueError as exc:
+        reasons.append(f"{what}: {exc}")
+        return None
+
+
+def _valid(poly: Polygon | MultiPolygon) -> Polygon | MultiPolygon:
+    """The polygon itself if valid, else its repair (a bow-tie ring becomes two triangles)."""
+    if poly.is_valid:
+        return poly
+    # make_valid keeps every lobe (buffer(0) can drop one) but may add lines: keep the areas.
+    repaired = shapely.make_valid(poly)
+    parts = [g for g in getattr(repaired, "geoms", [repaired]) if isinstance(g, Polygon)]
+    parts += [p for g in getattr(repaired, "geoms", []) if isinstance(g, MultiPolygon)
+              for p in g.geoms]
+    return unary_union(parts) if parts else Polygon()

@@ -1,0 +1,150 @@
+"""The methods the comparison knows, wired explicitly: 2D-S, 2D-SS and neural3d.
+
+Each builder returns a :class:`~metrics.runner.MethodSpec` whose ``run`` reads a
+scene folder and returns the method's :class:`~dataset.results.MethodResult`.
+A method whose package cannot be imported still gets a spec: its runs fail
+with the import error as the reason, and the other methods go on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any, Literal
+
+from dataset.scene import read_scene
+from metrics.runner import MethodSpec
+
+MethodName = Literal["2D-S", "2D-SS", "neural3d"]
+METHODS: tuple[str, ...] = ("2D-S", "2D-SS", "neural3d")
+VIEW_PROTOCOLS: tuple[str, ...] = ("ideal", "multi")
+NEURAL3D_PROTOCOL = "train"
+NEURAL3D_RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
+
+
+@dataclass(frozen=True)
+class Neural3dBudget:
+    """How neural3d trains inside a comparison: preset, time limit and device."""
+
+    preset: Literal["paper", "fast", "tiny"] = "fast"
+    minutes: float = 2.0
+    device: str = "cpu"
+
+    def __post_init__(self) -> None:
+        if not self.minutes > 0:
+            raise ValueError(f"neural3d minutes must be > 0, got {self.minutes}")
+
+
+def method_specs(
+    names: tuple[str, ...],
+    views: tuple[str, ...],
+    results_dir: Path,
+    *,
+    neural3d: Neural3dBudget = Neural3dBudget(),
+) -> list[MethodSpec]:
+    """Specs of the named methods; 2D methods run on ``views``, neural3d on its train views.
+
+    Raises
+    ------
+    ValueError
+        If a method name or a views protocol is unknown.
+    """
+    for name in names:
+        if name not in METHODS:
+            raise ValueError(f"unknown method {name!r}; choose from {', '.join(METHODS)}")
+    for view in views:
+        if view not in VIEW_PROTOCOLS:
+            raise ValueError(f"unknown views {view!r}; choose from {', '.join(VIEW_PROTOCOLS)}")
+    builders = {
+        "2D-S": lambda: spec_2ds(views),
+        "2D-SS": lambda: spec_2dss(views),
+        "neural3d": lambda: spec_neural3d(results_dir / NEURAL3D_RUNS_FOLDER, neural3d),
+    }
+    return [builders[name]() for name in names]
+
+
+def spec_2ds(views: tuple[str, ...]) -> MethodSpec:
+    """2D-S with its default config (``baselines.wwr2ds``)."""
+    try:
+        from baselines.wwr2ds import Wwr2dsConfig, run_2ds
+    except ImportError as exc:
+        return _unavailable("2D-S", views, exc)
+    config = Wwr2dsConfig()
+
+    def run(scene_dir: Path, protocol: str):
+        return run_2ds(read_scene(scene_dir), protocol, config)
+
+    return MethodSpec("2D-S", views, _config_dict(config), run)
+
+
+def spec_2dss(views: tuple[str, ...]) -> MethodSpec:
+    """2D-SS with its default config (``baselines.wwr2dss``)."""
+    try:
+        from baselines.wwr2dss import Wwr2dssConfig, run_2dss
+    except ImportError as exc:
+        return _unavailable("2D-SS", views, exc)
+    config = Wwr2dssConfig()
+
+    def run(scene_dir: Path, protocol: str):
+        return run_2dss(read_scene(scene_dir), protocol, config)
+
+    return MethodSpec("2D-SS", views, _config_dict(config), run)
+
+
+def debug_images_2dss(scene_dir: Path, protocol: str, debug_dir: Path) -> None:
+    """Run 2D-SS once more on one scene only to write its pipeline images into ``debug_dir``."""
+    from baselines.wwr2dss import Wwr2dssConfig, run_2dss
+
+    run_2dss(read_scene(scene_dir), protocol, Wwr2dssConfig(), debug_dir=debug_dir)
+
+
+def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
+    """neural3d: time-limited training (``neural3d.train``) then extraction (``neural3d.extract``).
+
+    The result's config gets a ``budget`` entry (preset, seconds, device) so a
+    result trained with another budget is recomputed.
+    """
+    protocols = (NEURAL3D_PROTOCOL,)
+    try:
+        # isort sees a module as first-party only once its file exists: keep this block as is.
+        from neural3d.config import preset_config  # noqa: I001
+        from neural3d.extract import ExtractConfig, extract_run
+        from neural3d.train import train
+    except ImportError as exc:
+        return _unavailable("neural3d", protocols, exc, has_footprint=True)
+    train_config = preset_config(budget.preset)
+    extract_config = ExtractConfig()
+    budget_dict = {"preset": budget.preset, "max_seconds": budget.minutes * 60.0}
+
+    def run(scene_dir: Path, protocol: str):
+        import torch
+
+        device = torch.device(budget.device)
+        run_dir = train(scene_dir, train_config, runs_dir, device=device,
+                        max_seconds=budget.minutes * 60.0)
+        result = extract_run(run_dir, config=extract_config, device=device)
+        return replace(result, config={**result.config, "budget": budget_dict})
+
+    requested = {"budget": budget_dict}
+    return MethodSpec("neural3d", protocols, requested, run, has_footprint=True)
+
+
+def neural3d_run_dir(results_dir: Path, scene: str) -> Path:
+    """The run folder neural3d trains a scene into (mesh.ply and footprint.geojson live there)."""
+    return results_dir / NEURAL3D_RUNS_FOLDER / scene
+
+
+def _config_dict(config: Any) -> dict[str, Any]:
+    return asdict(config) if hasattr(config, "__dataclass_fields__") else dict(config)
+
+
+def _unavailable(
+    name: str, protocols: tuple[str, ...], exc: ImportError, *, has_footprint: bool = False
+) -> MethodSpec:
+    reason = f"method {name} is not available: {exc}"
+
+    def run(scene_dir: Path, protocol: str):
+        raise RuntimeError(reason)
+
+    # An empty config matches any stored result, so earlier results are still used.
+    return MethodSpec(name, protocols, {}, run, has_footprint=has_footprint)

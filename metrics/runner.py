@@ -1,0 +1,152 @@
+"""Run only the missing (scene, method, protocol) results; reuse the ones already on disk.
+
+A stored result is reused when it reads back and its config matches the one
+requested (every key of the requested config has the same value in the
+stored one, compared as JSON). Otherwise the method runs and its result is
+written with :func:`dataset.results.write_result`. A method that raises is
+recorded as a failed outcome with its reason; the other runs go on.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Literal
+
+from tqdm import tqdm
+
+from dataset.results import MethodResult, read_result, result_filename, write_result
+
+RunFn = Callable[[Path, str], MethodResult]
+"""(scene folder, protocol) -> the method's result for that scene; may raise."""
+OutcomeStatus = Literal["reused", "ran", "failed"]
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """A method as the comparison runs it.
+
+    ``config`` is the config the method will run with, as it appears in its
+    result JSON; ``has_footprint`` says whether it estimates a footprint.
+    """
+
+    name: str
+    protocols: tuple[str, ...]
+    config: dict[str, Any]
+    run: RunFn
+    has_footprint: bool = False
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What happened to one (scene, method, protocol); ``result`` is ``None`` if it failed."""
+
+    scene: str
+    method: str
+    protocol: str
+    status: OutcomeStatus
+    result: MethodResult | None = None
+    reason: str = ""
+    path: Path | None = None
+
+
+def find_scenes(data: str | Path) -> list[Path]:
+    """Scene folders in ``data``: ``data`` itself if it is one, else its sub-folders that are.
+
+    A scene folder holds ``transforms.json`` (images to run methods on) or
+    ``building.json`` (ground truth). Raises ``ValueError`` when there is none.
+    """
+    data = Path(data)
+    if not data.is_dir():
+        raise ValueError(f"data folder {data} does not exist")
+    if _is_scene(data):
+        return [data]
+    scenes = sorted(p for p in data.iterdir() if p.is_dir() and _is_scene(p))
+    if not scenes:
+        raise ValueError(
+            f"{data} holds no scene folder (one with transforms.json or building.json); "
+            "make a benchmark with `python -m dataset.generate --preset tiny --out DIR`"
+        )
+    return scenes
+
+
+def config_matches(requested: dict[str, Any], stored: dict[str, Any]) -> bool:
+    """Whether every key of ``requested`` has the same value in ``stored`` (nested, as JSON)."""
+    return _subset(_as_json(requested), _as_json(stored))
+
+
+def run_missing(
+    scene_dirs: Sequence[Path],
+    specs: Sequence[MethodSpec],
+    results_dir: str | Path,
+    *,
+    allow_run: bool = True,
+    log: Callable[[str], None] = tqdm.write,
+) -> list[Outcome]:
+    """One :class:`Outcome` per (scene, method, protocol), in that nesting order.
+
+    With ``allow_run=False`` nothing runs: any stored result is used whatever
+    its config, and a missing one is a failed outcome.
+    """
+    results_dir = Path(results_dir)
+    jobs = [(s, spec, p) for s in scene_dirs for spec in specs for p in spec.protocols]
+    outcomes = []
+    for scene_dir, spec, protocol in tqdm(jobs, desc="results", unit="run", leave=False):
+        outcomes.append(_one(scene_dir, spec, protocol, results_dir, allow_run, log))
+    return outcomes
+
+
+def _one(
+    scene_dir: Path, spec: MethodSpec, protocol: str, results_dir: Path, allow_run: bool,
+    log: Callable[[str], None],
+) -> Outcome:
+    scene = scene_dir.name
+    path = results_dir / result_filename(scene, spec.name, protocol)
+    stale = ""
+    if path.is_file():
+        try:
+            stored = read_result(path)
+        except ValueError as exc:
+            stale = f"corrupt result file: {exc}"
+        else:
+            if not allow_run or config_matches(spec.config, stored.config):
+                return Outcome(scene, spec.name, protocol, "reused", stored, path=path)
+            stale = "stored result has another config"
+    if not allow_run:
+        reason = stale or f"no result file {path.name} (run without --no-run to compute it)"
+        log(f"{scene} / {spec.name} / {protocol}: {reason}")
+        return Outcome(scene, spec.name, protocol, "failed", reason=reason, path=path)
+    if stale:
+        log(f"{scene} / {spec.name} / {protocol}: {stale}; recomputing")
+    start = time.perf_counter()
+    try:
+        result = spec.run(scene_dir, protocol)
+    except Exception as exc:  # one failing method must not stop the comparison
+        reason = f"{type(exc).__name__}: {exc}".strip()
+        log(f"{scene} / {spec.name} / {protocol}: failed: {reason}")
+        return Outcome(scene, spec.name, protocol, "failed", reason=reason)
+    if result.scene != scene:
+        result = replace(result, scene=scene)
+    if not result.wall_time_s:
+        result = replace(result, wall_time_s=time.perf_counter() - start)
+    path = write_result(results_dir, result)
+    return Outcome(scene, spec.name, protocol, "ran", result, path=path)
+
+
+def _is_scene(folder: Path) -> bool:
+    return (folder / "transforms.json").is_file() or (folder / "building.json").is_file()
+
+
+def _as_json(obj: Any) -> Any:
+    return json.loads(json.dumps(obj, default=str))
+
+
+def _subset(requested: Any, stored: Any) -> bool:
+    if isinstance(requested, dict):
+        return isinstance(stored, dict) and all(
+            k in stored and _subset(v, stored[k]) for k, v in requested.items()
+        )
+    return requested == stored
