@@ -1,0 +1,1 @@
+"""Small example inputs shipped for tests and docs (each with the script that makes it)."""
