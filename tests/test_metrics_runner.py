@@ -1,0 +1,99 @@
+"""Running only what is missing: reuse by config, recompute on change or corruption, failures."""
+
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+from metrics_helpers import make_result, make_truth
+
+from dataset.results import read_result
+from dataset.truth import write_building
+from metrics.runner import MethodSpec, config_matches, find_scenes, run_missing
+
+
+class FakeMethod:
+    """A method that counts its calls and fails on scenes named in ``fail_on``."""
+
+    def __init__(self, config, fail_on=()):
+        self.config, self.fail_on, self.calls = config, set(fail_on), []
+
+    def __call__(self, scene_dir: Path, protocol: str):
+        self.calls.append((scene_dir.name, protocol))
+        if scene_dir.name in self.fail_on:
+            raise RuntimeError("no facade pixels in any view")
+        result = make_result("ignored-name", "fake", protocol, 0.25)
+        return replace(result, config=dict(self.config))
+
+
+def _scenes(root: Path, names=("a", "b")) -> list[Path]:
+    for name in names:
+        write_building(root / name / "building.json", make_truth(name))
+    return find_scenes(root)
+
+
+def test_config_matches_is_a_nested_subset_test():
+    stored = {"a": 1, "b": {"c": [1, 2], "d": "x"}, "extra": True}
+    assert config_matches({}, stored)
+    assert config_matches({"a": 1, "b": {"c": (1, 2)}}, stored)  # tuples compare as JSON lists
+    assert not config_matches({"a": 2}, stored)
+    assert not config_matches({"b": {"d": "y"}}, stored)
+    assert not config_matches({"missing": 1}, stored)
+
+
+def test_runs_missing_then_reuses_then_recomputes_on_config_change(tmp_path):
+    scenes = _scenes(tmp_path / "data")
+    method = FakeMethod({"k": 1})
+    spec = MethodSpec("fake", ("ideal", "multi"), {"k": 1}, method)
+    out = run_missing(scenes, [spec], tmp_path / "results", log=lambda _: None)
+    assert [(o.scene, o.protocol, o.status) for o in out] == [
+        ("a", "ideal", "ran"), ("a", "multi", "ran"), ("b", "ideal", "ran"), ("b", "multi", "ran")
+    ]
+    stored = read_result(tmp_path / "results" / "a__fake__ideal.json")
+    assert stored.scene == "a"  # the file is named and filled after the scene folder
+    again = run_missing(scenes, [spec], tmp_path / "results", log=lambda _: None)
+    assert {o.status for o in again} == {"reused"} and len(method.calls) == 4
+    changed = MethodSpec("fake", ("ideal",), {"k": 2}, FakeMethod({"k": 2}))
+    messages = []
+    redo = run_missing(scenes, [changed], tmp_path / "results", log=messages.append)
+    assert [o.status for o in redo] == ["ran", "ran"]
+    assert "another config" in messages[0]
+
+
+def test_failure_is_recorded_and_the_rest_runs(tmp_path):
+    scenes = _scenes(tmp_path / "data", ("a", "b", "c"))
+    spec = MethodSpec("fake", ("ideal",), {}, FakeMethod({}, fail_on={"b"}))
+    out = run_missing(scenes, [spec], tmp_path / "results", log=lambda _: None)
+    assert [o.status for o in out] == ["ran", "failed", "ran"]
+    assert out[1].reason == "RuntimeError: no facade pixels in any view"
+    assert not (tmp_path / "results" / "b__fake__ideal.json").exists()
+
+
+def test_corrupt_file_is_reported_and_recomputed_or_failed(tmp_path):
+    scenes = _scenes(tmp_path / "data", ("a",))
+    results = tmp_path / "results"
+    results.mkdir()
+    (results / "a__fake__ideal.json").write_text("{not json")
+    messages = []
+    spec = MethodSpec("fake", ("ideal",), {}, FakeMethod({}))
+    read_only = run_missing(scenes, [spec], results, allow_run=False, log=messages.append)
+    assert read_only[0].status == "failed"
+    assert "corrupt result file" in read_only[0].reason and "is not a valid result" in messages[0]
+    redo = run_missing(scenes, [spec], results, log=messages.append)
+    assert redo[0].status == "ran" and "recomputing" in messages[-1]
+    assert read_result(results / "a__fake__ideal.json").wwr == 0.25
+
+
+def test_no_run_reports_missing_results(tmp_path):
+    scenes = _scenes(tmp_path / "data", ("a",))
+    spec = MethodSpec("fake", ("ideal",), {"k": 1}, FakeMethod({}))
+    out = run_missing(scenes, [spec], tmp_path / "results", allow_run=False, log=lambda _: None)
+    assert out[0].status == "failed" and "no result file a__fake__ideal.json" in out[0].reason
+
+
+def test_find_scenes(tmp_path):
+    assert find_scenes(_scenes(tmp_path / "data", ("a",))[0]) == [tmp_path / "data" / "a"]
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="holds no scene folder"):
+        find_scenes(tmp_path / "empty")
+    with pytest.raises(ValueError, match="does not exist"):
+        find_scenes(tmp_path / "nope")
