@@ -1,0 +1,239 @@
+"""2D-SS: the improved 2D method with scale (Szczesniak et al. 2022), on ideal or multi views.
+
+Per view (see each module for the details):
+
+1. isolate the target facade with the semantic mask and depth
+   (:func:`baselines.facade_mask.isolate_facade_on_plane`);
+2. the four corners of the quadrilateral that best encloses it
+   (:func:`baselines.corners.enclosing_quadrilateral`);
+3. the corners' rays meet the facade plane: facade length L, height H, alpha = L / H
+   (:mod:`baselines.backproject`);
+4. a homography maps the quadrilateral onto a fronto-parallel rectangle of
+   aspect alpha; all views of a run are warped with kornia in batches and the
+   WWR is window / facade pixels inside the rectangle (:mod:`baselines.rectify`).
+
+Per facade, WWR, L and H are the mean (or median) over its views; facade area
+= L H and window area = WWR L H. Building WWR = sum(WWR_i alpha_i) / sum(alpha_i)
+as in the paper, or with ``weighting="area"`` sum(WWR_i A_i) / sum(A_i).
+
+    python -m baselines.wwr2dss --views ideal --data DIR [--weighting alpha|area] [--out DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+import torch
+
+from baselines.aggregate import COMBINES, Combine, building_result, combine_values, missing_facade
+from baselines.backproject import corners_camera_m, facade_size_m
+from baselines.cli import add_common_arguments, main_guarded, run_scenes
+from baselines.corners import corners_inside_image, enclosing_quadrilateral
+from baselines.debug import colour_labels, draw_corners, write_debug_image
+from baselines.facade_mask import PlaneIsolationConfig, isolate_facade_on_plane
+from baselines.rectify import OUTSIDE, rectangle_size_px, rectified_wwr, rectify_labels
+from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
+from dataset.images import read_rgb
+from dataset.results import FacadeEstimate, MethodResult
+from dataset.scene import Scene
+
+METHOD = "2D-SS"
+
+
+@dataclass(frozen=True)
+class Wwr2dssConfig:
+    """2D-SS options.
+
+    ``weighting``: building WWR weights, "alpha" (L/H, the paper) or "area" (L H).
+    ``combine``: how the views of one facade are combined. ``canvas_px``: side of
+    the square canvas the facades are rectified onto. ``batch_size``: views
+    warped per kornia call. ``corner_margin_px``: a corner closer than this to
+    the image border (or outside) means the facade is cut off; the view is
+    skipped. ``seed``: RANSAC randomness.
+    """
+
+    weighting: Literal["alpha", "area"] = "alpha"
+    combine: Combine = "mean"
+    isolation: PlaneIsolationConfig = field(default_factory=PlaneIsolationConfig)
+    canvas_px: int = 512
+    batch_size: int = 32
+    corner_margin_px: float = 1.0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.weighting not in ("alpha", "area"):
+            raise ValueError(f"weighting must be 'alpha' or 'area', got {self.weighting!r}")
+        if self.combine not in COMBINES:
+            raise ValueError(f"combine must be one of {COMBINES}, got {self.combine!r}")
+        if self.canvas_px < 8 or self.batch_size < 1:
+            raise ValueError("canvas_px must be >= 8 and batch_size >= 1")
+
+
+@dataclass(frozen=True)
+class ViewGeometry:
+    """The geometric half of 2D-SS on one view (before rectification).
+
+    ``mask`` (H, W) bool; ``corners_uv`` (4, 2) image corners TL, TR, BR, BL;
+    ``corners_m`` (4, 3) the same in the camera frame (m).
+    """
+
+    view: FacadeView
+    mask: np.ndarray
+    corners_uv: np.ndarray
+    corners_m: np.ndarray
+    length_m: float
+    height_m: float
+
+
+def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
+                          rng: np.random.Generator) -> ViewGeometry:
+    """Facade mask, corners, and the facade's length and height in one view.
+
+    Raises
+    ------
+    ViewError
+        If the view has no facade pixels, no depth on them, corners outside the
+        image, or a facade plane seen edge-on.
+    """
+    if view.depth_z_m is None:
+        raise ViewError("2D-SS needs a depth image")
+    k = view.intrinsics
+    mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, config.isolation, rng)
+    corners = enclosing_quadrilateral(mask)
+    corners_inside_image(corners, k.width, k.height, config.corner_margin_px)
+    corners_m = corners_camera_m(corners, plane, k)
+    length, height = facade_size_m(corners_m)
+    return ViewGeometry(view, mask, corners, corners_m, length, height)
+
+
+def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
+                  device: torch.device | str = "cpu", *, keep_images: bool = False
+                  ) -> tuple[np.ndarray, list[np.ndarray | None]]:
+    """WWR of each view measured in its rectified label image (batched kornia warps).
+
+    Returns
+    -------
+    wwr : (N,) float, NaN where the rectangle holds no facade pixel
+    rectified : N (h_i, w_i) uint8 label images cropped to their rectangles
+        when ``keep_images``, else N ``None``
+    """
+    wwr = np.full(len(geometries), np.nan)
+    images: list[np.ndarray | None] = [None] * len(geometries)
+    sizes = np.array([rectangle_size_px(g.length_m / g.height_m, config.canvas_px)
+                      for g in geometries]).reshape(-1, 2)
+    by_shape: dict[tuple[int, int], list[int]] = {}
+    for i, g in enumerate(geometries):
+        by_shape.setdefault(g.view.labels.shape, []).append(i)
+    for idx in by_shape.values():
+        for start in range(0, len(idx), config.batch_size):
+            batch = idx[start:start + config.batch_size]
+            rect = rectify_labels(
+                np.stack([geometries[i].view.labels for i in batch]),
+                np.stack([geometries[i].corners_uv for i in batch]),
+                sizes[batch], config.canvas_px, device,
+            )
+            wwr[batch] = rectified_wwr(rect)
+            if keep_images:
+                for j, i in enumerate(batch):
+                    images[i] = rect[j, : sizes[i, 1], : sizes[i, 0]]
+    return wwr, images
+
+
+def run_2dss(scene: Scene, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssConfig(), *,
+             debug_dir: Path | None = None, device: torch.device | str = "cpu") -> MethodResult:
+    """2D-SS on one scene's ideal or multi views.
+
+    Raises
+    ------
+    ValueError
+        If the protocol is unknown, the scene has no such views, or no view is usable.
+    """
+    start = time.perf_counter()
+    loaded = load_views(scene, protocol, depth="required")
+    geometries: list[ViewGeometry] = []
+    for n, view in enumerate(loaded.views):
+        try:
+            geometries.append(measure_view_geometry(
+                view, config, np.random.default_rng((config.seed, n))))
+        except ViewError as exc:
+            loaded.skip(view.name, view.facade_id, str(exc))
+    wwr, rectified = rectify_views(geometries, config, device, keep_images=debug_dir is not None)
+    per_facade: dict[int, list[tuple[ViewGeometry, float]]] = {f: [] for f in loaded.facade_ids}
+    for g, r in zip(geometries, wwr):
+        if np.isnan(r):
+            loaded.skip(g.view.name, g.view.facade_id, "no facade pixels in the rectified facade")
+            continue
+        per_facade[g.view.facade_id].append((g, float(r)))
+    if debug_dir is not None:
+        _write_debug(debug_dir, scene, protocol, geometries, rectified)
+    facades = [
+        _facade_estimate(fid, ms, config) if ms
+        else missing_facade(fid, loaded.skipped.get(fid, []))
+        for fid, ms in per_facade.items()
+    ]
+    return building_result(
+        scene=scene_name(scene), method=METHOD, protocol=protocol, facades=facades,
+        weighting=config.weighting, config=asdict(config),
+        wall_time_s=time.perf_counter() - start, warnings=loaded.warnings,
+    )
+
+
+def _facade_estimate(fid: int, ms: list[tuple[ViewGeometry, float]],
+                     config: Wwr2dssConfig) -> FacadeEstimate:
+    wwr = combine_values([r for _, r in ms], config.combine)
+    length = combine_values([g.length_m for g, _ in ms], config.combine)
+    height = combine_values([g.height_m for g, _ in ms], config.combine)
+    area = length * height
+    return FacadeEstimate(id=fid, wwr=wwr, window_area_m2=wwr * area, facade_area_m2=area,
+                          width_m=length, height_m=height, views_used=len(ms))
+
+
+def _write_debug(folder: Path, scene: Scene, protocol: str, geometries: list[ViewGeometry],
+                 rectified: list[np.ndarray | None]) -> None:
+    for g, rect in zip(geometries, rectified):
+        v = g.view
+        try:
+            base = read_rgb(scene.path(v.frame.file_path))
+        except ValueError:  # the RGB photo is only decoration here; the labels will do
+            base = colour_labels(v.labels)
+        args = (folder, v.scene, protocol, v.facade_id, v.view_index)
+        write_debug_image(*args, "mask", colour_labels(v.labels, g.mask))
+        write_debug_image(*args, "corners", draw_corners(base, g.corners_uv))
+        if rect is not None:
+            write_debug_image(*args, "rectified", colour_labels(np.where(
+                rect == OUTSIDE, 0, rect)))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m baselines.wwr2dss",
+        description="2D-SS baseline: facade corners from the semantic mask, back-projected "
+                    "with depth to get facade length L and height H; the facade is rectified "
+                    "to an L:H rectangle and its WWR measured there; building WWR weighted by "
+                    "L/H (paper) or by area. Writes <scene>__2D-SS__<views>.json per scene.",
+    )
+    add_common_arguments(parser)
+    parser.add_argument("--weighting", choices=("alpha", "area"),
+                        default=Wwr2dssConfig.weighting,
+                        help="building WWR weights: alpha = L/H as in the paper (default), "
+                             "area = L*H")
+    parser.add_argument("--combine", choices=COMBINES, default=Wwr2dssConfig.combine,
+                        help="how the views of one facade are combined (default: mean)")
+    parser.add_argument("--device", default="cpu", help="torch device for the warps")
+    args = parser.parse_args(argv)
+
+    def body() -> int:
+        config = Wwr2dssConfig(weighting=args.weighting, combine=args.combine)
+        return run_scenes(args.data, args.out, lambda s: run_2dss(
+            s, args.views, config, debug_dir=args.debug_images, device=args.device))
+
+    return main_guarded(parser.prog, body)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
