@@ -1,0 +1,47 @@
+"""Shared look of the figures: class colours and image encodings for display."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dataset.classes import NUM_CLASSES
+
+# RGB of class ids 0..5: background, wall, window, roof, door, other (as in the debug images).
+CLASS_RGB = np.array(
+    [(0, 0, 0), (200, 200, 200), (40, 110, 230), (170, 60, 50), (140, 90, 40), (60, 160, 70)],
+    dtype=np.uint8,
+)
+UNKNOWN_CLASS_RGB = (255, 0, 255)  # ids beyond the known classes stand out
+
+
+class MissingInput(ValueError):
+    """A figure's input is not there (yet); the figure is skipped with this message."""
+
+
+def colour_labels(labels: np.ndarray) -> np.ndarray:
+    """(H, W) class ids -> (H, W, 3) uint8 colours (:data:`CLASS_RGB`)."""
+    palette = np.tile(np.array(UNKNOWN_CLASS_RGB, dtype=np.uint8), (256, 1))
+    palette[:NUM_CLASSES] = CLASS_RGB
+    return palette[np.asarray(labels, dtype=np.uint8)]
+
+
+def colour_normals(normals_world: np.ndarray) -> np.ndarray:
+    """(H, W, 3) unit normals -> (H, W, 3) uint8 as (n + 1) / 2; no surface (zero) is black."""
+    n = np.asarray(normals_world, dtype=np.float64)
+    rgb = np.round((np.clip(n, -1, 1) + 1) / 2 * 255).astype(np.uint8)
+    rgb[(n == 0).all(axis=-1)] = 0
+    return rgb
+
+
+def colour_depth(depth_z_m: np.ndarray) -> np.ndarray:
+    """(H, W) z-depth (0 = none) -> (H, W, 3) uint8, near bright, far dark, none white."""
+    from matplotlib import colormaps
+
+    d = np.asarray(depth_z_m, dtype=np.float64)
+    hit = d > 0
+    rgb = np.full(d.shape + (3,), 255, dtype=np.uint8)
+    if hit.any():
+        lo, hi = np.percentile(d[hit], [1, 99])
+        t = np.clip((d - lo) / max(hi - lo, 1e-9), 0, 1)
+        rgb[hit] = (colormaps["magma"](1 - 0.85 * t[hit])[:, :3] * 255).astype(np.uint8)
+    return rgb
