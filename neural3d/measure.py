@@ -78,8 +78,10 @@ class MeshFacade:
 
     ``normal`` is the horizontal outward unit vector (world, z = 0) at
     ``azimuth_deg`` (counter-clockwise from +x); ``offset_m`` the plane's
-    distance from the origin along it; ``width_m`` the extent of its triangles
-    along the wall (a chord for a curved segment), ``height_m`` their z extent.
+    distance from the origin along it; ``height_m`` the z extent of its
+    triangles and ``width_m`` the gross area over the height: exact for a
+    rectangular facade, the arc length for a curved one, and, unlike an extent
+    along the wall, blind to stray triangles whose normals join a neighbour.
     """
 
     index: int
@@ -221,20 +223,20 @@ def _facade_figures(
     weight = a[:, list(FACADE_CLASSES)].sum(axis=1)
     azimuth, offset = _azimuth_offset(n, tri.mean(axis=1)[:, :2], weight)
     u = np.array([np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))])
-    along = tri.reshape(-1, 3)[:, :2] @ np.array([-u[1], u[0]])
-    z = tri[..., 2]
+    height = float(tri[..., 2].max() - tri[..., 2].min())
+    gross = gross_facade_area_m2(wall, window, door)
     return MeshFacade(
         index=index,
-        normal=(float(u[0]), float(u[1]), 0.0),
+        normal=(round(float(u[0]), 12) + 0.0, round(float(u[1]), 12) + 0.0, 0.0),
         azimuth_deg=float(azimuth),
         offset_m=offset,
         window_area_m2=window,
         wall_area_m2=wall,
         door_area_m2=door,
-        facade_area_m2=gross_facade_area_m2(wall, window, door),
+        facade_area_m2=gross,
         wwr=_wwr_or_none(window, wall, door),
-        width_m=float(along.max() - along.min()),
-        height_m=float(z.max() - z.min()),
+        width_m=gross / height if height > 0 else 0.0,
+        height_m=height,
         face_count=int(mask.sum()),
     )
 

@@ -52,3 +52,24 @@ def banded_labels(sdf_fn, band_z_m: tuple[float, float]):
         return out
 
     return label
+
+
+def truth_mesh_of(tm, *, curved: bool = False):
+    """LabelledMesh of a trimesh prism: side faces get facade ids by normal direction, from 1.
+
+    Faces facing up are roof, down background, both facade 0; sides are wall. Side faces
+    with the same azimuth (to 1 degree) share an id; ``curved=True`` gives every side face id 1.
+    """
+    from dataset.mesh import LabelledMesh
+
+    n = tm.face_normals
+    label = np.full(len(n), int(SemanticClass.WALL), dtype=np.uint8)
+    label[n[:, 2] > 0.7] = SemanticClass.ROOF
+    label[n[:, 2] < -0.7] = SemanticClass.BACKGROUND
+    side = np.abs(n[:, 2]) <= 0.7
+    azimuth = np.round(np.degrees(np.arctan2(n[:, 1], n[:, 0])) % 360).astype(int)
+    ids = {a: i + 1 for i, a in enumerate(sorted(set(azimuth[side].tolist())))}
+    facade = np.array([ids[a] if s else 0 for a, s in zip(azimuth, side)], dtype=np.int32)
+    if curved:
+        facade = side.astype(np.int32)
+    return LabelledMesh(np.asarray(tm.vertices), np.asarray(tm.faces), label, facade)

@@ -1,0 +1,279 @@
+"""Measure a trained semantic SDF: mesh, per-vertex semantics, WWR, footprint, result file.
+
+``python -m neural3d.extract --run DIR`` writes, into ``DIR/extract`` (or ``--out``):
+
+- ``mesh.ply``: marching-cubes mesh, per-vertex ``label`` (argmax of the semantic
+  head, mapped to :mod:`dataset.classes` ids by the run's class names) and RGB
+  from the colour network looking at the surface head-on (view direction =
+  -vertex normal, so the colour does not depend on where a camera happened to be);
+- ``footprint.geojson``: zero contour of the SDF at ``footprint_height_m``;
+- ``<scene>__neural3d__train.json``: the :class:`dataset.results.MethodResult`.
+
+Per-facade figures carry the ground truth's facade ids when the run's scene
+folder has ``mesh.ply`` (see :mod:`neural3d.facade_match`); otherwise the mesh's
+own group numbers from 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from dataset.atomic import write_json_atomic
+from dataset.classes import NUM_CLASSES, class_id_from_name
+from dataset.footprint import polygon_to_geojson
+from dataset.mesh import read_labelled_ply
+from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
+from neural3d.device import resolve_device
+from neural3d.facade_match import facades_by_truth
+from neural3d.footprint import footprint_from_sdf
+from neural3d.measure import MeasureConfig, MeshFacade, measure_semantic_mesh
+from neural3d.meshing import (
+    ColorFn,
+    LabelFn,
+    SdfFn,
+    SemanticMesh,
+    color_vertices,
+    extract_mesh,
+    label_vertices,
+    write_semantic_ply,
+)
+
+METHOD = "neural3d"
+PROTOCOL = "train"
+
+
+@dataclass(frozen=True)
+class ExtractConfig:
+    """Everything that turns a trained field into measurements (the one source of defaults).
+
+    ``resolution`` is the number of marching-cubes samples along the scene box's
+    longest side. The footprint plane sits ``footprint_height_m`` above the
+    ground (z = 0): above the ground's reconstruction noise, below sills and overhangs.
+    """
+
+    resolution: int = 256
+    chunk_points: int = 1 << 16
+    min_component_area_fraction: float = 0.01  # floaters of a neural SDF
+    footprint_height_m: float = 0.5
+    footprint_cell_m: float = 0.05
+    footprint_min_area_m2: float = 1.0
+    match_truth_facades: bool = True
+    measure: MeasureConfig = field(default_factory=MeasureConfig)
+
+    def __post_init__(self) -> None:
+        if self.resolution < 8:
+            raise ValueError(f"resolution must be >= 8, got {self.resolution}")
+        if self.chunk_points < 1:
+            raise ValueError(f"chunk_points must be >= 1, got {self.chunk_points}")
+
+
+def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
+    """NumPy SDF callable (N, 3) world m -> (N,) m of a ``TrainedField``."""
+
+    def sdf(points_m: np.ndarray) -> np.ndarray:
+        return _batched(lambda p: trained.sdf_m(p), points_m, device, chunk_points)
+
+    return sdf
+
+
+def field_label_fn(trained, device: torch.device, chunk_points: int) -> LabelFn:
+    """NumPy class-id callable (N, 3) -> (N,) :mod:`dataset.classes` ids (semantic-head argmax)."""
+    class_ids = _class_ids_of(trained.class_names)
+
+    def label(points_m: np.ndarray) -> np.ndarray:
+        logits = _batched(lambda p: trained.semantic_logits(p), points_m, device, chunk_points)
+        if logits.ndim != 2 or logits.shape[1] != len(class_ids):
+            raise ValueError(f"semantic head gave shape {logits.shape}; expected "
+                             f"(N, {len(class_ids)}) for classes {trained.class_names}")
+        return class_ids[np.argmax(logits, axis=1)]
+
+    return label
+
+
+def field_color_fn(trained, device: torch.device, chunk_points: int) -> ColorFn:
+    """NumPy colour callable (points (N, 3), view dirs (N, 3)) -> (N, 3) in [0, 1]."""
+
+    def color(points_m: np.ndarray, view_dirs: np.ndarray) -> np.ndarray:
+        both = np.concatenate([points_m, view_dirs], axis=1)
+        # no no_grad here: the colour network may need the SDF gradient (normals) by autograd
+        return _batched(lambda x: trained.rgb(x[:, :3], x[:, 3:]), both, device, chunk_points,
+                        grad=True)
+
+    return color
+
+
+def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device) -> SemanticMesh:
+    """Marching-cubes mesh of the field over its box, with vertex classes and colours."""
+    sdf = field_sdf_fn(trained, device, config.chunk_points)
+    vertices_m, faces = extract_mesh(
+        sdf, trained.box_min_m, trained.box_max_m, resolution=config.resolution,
+        chunk_points=config.chunk_points,
+        min_component_area_fraction=config.min_component_area_fraction,
+    )
+    labels = label_vertices(vertices_m, field_label_fn(trained, device, config.chunk_points),
+                            chunk_points=config.chunk_points)
+    rgb = color_vertices(vertices_m, faces, field_color_fn(trained, device, config.chunk_points),
+                         chunk_points=config.chunk_points)
+    return SemanticMesh(vertices_m, faces, labels, rgb)
+
+
+def measure_field(
+    trained, config: ExtractConfig, *, device: torch.device | None = None
+) -> tuple[MethodResult, SemanticMesh]:
+    """Mesh, measure and outline a trained field; nothing is written.
+
+    Parameters
+    ----------
+    trained : neural3d.trained.TrainedField
+    config : ExtractConfig (use a modest ``resolution``, e.g. 128, while training)
+    device : where to evaluate the field; None takes ``trained.device`` if it has one, else CPU.
+
+    Returns
+    -------
+    result : MethodResult (method "neural3d", protocol "train"); a footprint that
+        cannot be found becomes ``None`` with a warning.
+    mesh : SemanticMesh
+
+    Raises
+    ------
+    ValueError
+        If the field has no surface in its box.
+    """
+    start = time.perf_counter()
+    device = device if device is not None else getattr(trained, "device", torch.device("cpu"))
+    mesh = semantic_mesh_of_field(trained, config, device)
+    m = measure_semantic_mesh(mesh.vertices_m, mesh.faces, mesh.vertex_labels,
+                              config=config.measure)
+    warnings: list[str] = []
+    if m.wwr is None:
+        warnings.append("the mesh has no wall, window or door vertex: WWR undefined")
+    facades = _facade_estimates(trained, mesh, m, config, warnings)
+    try:
+        polygon = footprint_from_sdf(
+            field_sdf_fn(trained, device, config.chunk_points), trained.box_min_m,
+            trained.box_max_m, height_m=config.footprint_height_m,
+            cell_m=config.footprint_cell_m, min_area_m2=config.footprint_min_area_m2,
+            chunk_points=config.chunk_points,
+        )
+        footprint = polygon_to_geojson(polygon)
+    except ValueError as exc:
+        footprint = None
+        warnings.append(f"no footprint: {exc}")
+    result = MethodResult(
+        scene=trained.scene_name, method=METHOD, protocol=PROTOCOL, wwr=m.wwr,
+        window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
+        footprint=footprint, config=asdict(config), code_version=code_version(),
+        wall_time_s=time.perf_counter() - start, warnings=tuple(warnings),
+    )
+    return result, mesh
+
+
+def extract_run(
+    run_dir: Path,
+    *,
+    config: ExtractConfig = ExtractConfig(),
+    device: torch.device,
+    out_dir: Path | None = None,
+) -> MethodResult:
+    """Load a trained run, measure it, and write mesh.ply, footprint.geojson and the result JSON.
+
+    ``out_dir`` defaults to ``run_dir / "extract"``. Everything is computed
+    before anything is written, and each file is written atomically.
+    """
+    from neural3d.trained import load_trained_field
+
+    run_dir = Path(run_dir)
+    if not run_dir.is_dir():
+        raise ValueError(f"run folder {run_dir} does not exist")
+    out_dir = Path(out_dir) if out_dir is not None else run_dir / "extract"
+    trained = load_trained_field(run_dir, device=device)
+    result, mesh = measure_field(trained, config, device=device)
+    write_semantic_ply(out_dir / "mesh.ply", mesh.vertices_m, mesh.faces, mesh.vertex_labels,
+                       mesh.vertex_rgb)
+    if result.footprint is not None:
+        write_json_atomic(out_dir / "footprint.geojson", result.footprint)
+    write_result(out_dir, result)
+    return result
+
+
+def _facade_estimates(trained, mesh: SemanticMesh, m, config: ExtractConfig,
+                      warnings: list[str]) -> tuple[FacadeEstimate, ...]:
+    truth_mesh_path = Path(trained.scene_dir) / "mesh.ply"
+    if not (config.match_truth_facades and truth_mesh_path.is_file()):
+        warnings.append("facade ids are the mesh's own group numbers (no truth mesh matched)")
+        return tuple(_estimate(f, f.index + 1) for f in m.facades)
+    truth_mesh = read_labelled_ply(truth_mesh_path)
+    matched, unmatched = facades_by_truth(mesh.vertices_m, mesh.faces, mesh.vertex_labels, m,
+                                          truth_mesh, config=config.measure)
+    if unmatched:
+        warnings.append(f"{len(unmatched)} mesh facade group(s) face no truth facade; left out")
+    truth_ids = sorted(set(np.unique(truth_mesh.face_facade).tolist()) - {0})
+    return tuple(
+        _estimate(matched[i], i) if i in matched else
+        FacadeEstimate(id=i, wwr=None, missing=True,
+                       reason="no facade of the mesh lies on this facade")
+        for i in truth_ids
+    )
+
+
+def _estimate(f: MeshFacade, facade_id: int) -> FacadeEstimate:
+    return FacadeEstimate(id=int(facade_id), wwr=f.wwr, window_area_m2=f.window_area_m2,
+                          facade_area_m2=f.facade_area_m2, width_m=f.width_m,
+                          height_m=f.height_m)
+
+
+def _class_ids_of(class_names) -> np.ndarray:
+    ids = np.array([int(class_id_from_name(n)) for n in class_names], dtype=np.int64)
+    if len(ids) == 0 or ids.max() >= NUM_CLASSES:
+        raise ValueError(f"the run's class names {class_names} do not map onto dataset classes")
+    return ids
+
+
+def _batched(fn, points: np.ndarray, device: torch.device, chunk_points: int, *,
+             grad: bool = False) -> np.ndarray:
+    outs = []
+    for start in range(0, len(points), chunk_points):
+        x = torch.as_tensor(points[start:start + chunk_points], dtype=torch.float32,
+                            device=device)
+        with torch.set_grad_enabled(grad):
+            outs.append(fn(x).detach().float().cpu().numpy())
+    return np.concatenate(outs) if outs else np.zeros((0,))
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m neural3d.extract",
+        description="Mesh a trained neural3d run and measure it: writes mesh.ply (per-vertex "
+                    "label and colour), footprint.geojson and the result JSON "
+                    "(<scene>__neural3d__train.json).",
+    )
+    parser.add_argument("--run", type=Path, required=True, help="trained run folder")
+    parser.add_argument("--resolution", type=int, default=ExtractConfig.resolution,
+                        help="marching-cubes samples along the scene box's longest side "
+                             f"(default {ExtractConfig.resolution})")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="output folder (default: RUN/extract)")
+    parser.add_argument("--device", choices=("cpu", "cuda"), default="cpu",
+                        help="where to evaluate the field (default cpu)")
+    args = parser.parse_args(argv)
+    try:
+        result = extract_run(args.run, config=ExtractConfig(resolution=args.resolution),
+                             device=resolve_device(args.device), out_dir=args.out)
+    except ValueError as exc:
+        print(f"neural3d.extract: {exc}", file=sys.stderr)
+        return 2
+    wwr = "n/a" if result.wwr is None else f"{result.wwr:.3f}"
+    print(f"{result.scene}: WWR {wwr}, facade {result.facade_area_m2:.1f} m², "
+          f"window {result.window_area_m2:.1f} m², {result.wall_time_s:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

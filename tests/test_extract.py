@@ -1,0 +1,113 @@
+"""neural3d.extract: an analytic field behind the TrainedField interface, the CLI, a real run."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+import trimesh
+from sdf_shapes import banded_labels, box_sdf, truth_mesh_of
+from shapely.geometry import box as rectangle
+
+import neural3d.trained
+from dataset.classes import CLASS_NAMES
+from dataset.footprint import geojson_to_polygon
+from dataset.mesh import write_labelled_ply
+from dataset.results import read_result, result_filename
+from neural3d.extract import ExtractConfig, extract_run, main, measure_field
+from neural3d.meshing import read_semantic_ply
+
+BOX_LO, BOX_HI = [-3.0, -2.0, 0.0], [3.0, 2.0, 10.0]  # window band 3-6 m: WWR 0.3
+
+
+class AnalyticField:
+    """The TrainedField interface over an analytic box; class names in reverse dataset order."""
+
+    def __init__(self, scene_dir: Path):
+        self.scene_dir = scene_dir
+        self.scene_name = scene_dir.name
+        self.class_names = tuple(reversed(CLASS_NAMES))
+        self.box_min_m = np.array([-4.0, -3.0, -0.5])
+        self.box_max_m = np.array([4.0, 3.0, 11.0])
+        self.device = torch.device("cpu")
+        self._labels = banded_labels(self._sdf, (3.0, 6.0))
+
+    @staticmethod
+    def _sdf(p):
+        return box_sdf(p, BOX_LO, BOX_HI)
+
+    def sdf_m(self, points):
+        return torch.as_tensor(self._sdf(points.double().numpy()))
+
+    def semantic_logits(self, points):
+        ids = self._labels(points.double().numpy())
+        logits = np.zeros((len(ids), len(CLASS_NAMES)))
+        logits[np.arange(len(ids)), len(CLASS_NAMES) - 1 - ids] = 5.0  # reversed class order
+        return torch.as_tensor(logits)
+
+    def rgb(self, points, view_dirs):
+        return (view_dirs + 1) / 2
+
+
+@pytest.fixture
+def scene_dir(tmp_path):
+    folder = tmp_path / "analytic_box"
+    folder.mkdir()
+    box = trimesh.creation.box(extents=[6, 4, 10],
+                               transform=trimesh.transformations.translation_matrix([0, 0, 5]))
+    write_labelled_ply(folder / "mesh.ply", truth_mesh_of(box))
+    return folder
+
+
+CONFIG = ExtractConfig(resolution=96, footprint_cell_m=0.1)
+
+
+def test_measure_field_on_an_analytic_field(scene_dir):
+    result, mesh = measure_field(AnalyticField(scene_dir), CONFIG)
+    assert (result.method, result.protocol, result.scene) == ("neural3d", "train", "analytic_box")
+    assert result.wwr == pytest.approx(0.3, abs=0.01)
+    assert result.facade_area_m2 == pytest.approx(200.0, rel=0.02)  # 0.12 m voxels cut edges
+    assert [f.id for f in result.facades] == [1, 2, 3, 4]  # the truth mesh's facade ids
+    assert all(f.wwr == pytest.approx(0.3, abs=0.015) for f in result.facades)
+    footprint = geojson_to_polygon(result.footprint)
+    truth = rectangle(-3, -2, 3, 2)
+    assert footprint.intersection(truth).area / footprint.union(truth).area >= 0.99
+    assert result.config["resolution"] == 96 and result.config["measure"]["count"] == "all"
+    # labels went through the class-name mapping: roof on top, never an unknown id
+    assert mesh.vertex_labels[np.argmax(mesh.vertices_m[:, 2])] == 3
+    assert mesh.vertex_rgb.dtype == np.uint8 and mesh.vertex_rgb.shape == (len(mesh.vertices_m), 3)
+
+
+def test_without_truth_mesh_ids_are_group_numbers(tmp_path):
+    result, _ = measure_field(AnalyticField(tmp_path), CONFIG)
+    assert [f.id for f in result.facades] == [1, 2, 3, 4]
+    assert any("group numbers" in w for w in result.warnings)
+
+
+def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
+    monkeypatch.setattr(neural3d.trained, "load_trained_field",
+                        lambda run_dir, device: AnalyticField(scene_dir))
+    run_dir = tmp_path / "run"
+    run_dir.mkdir()
+    result = extract_run(run_dir, config=CONFIG, device=torch.device("cpu"))
+    out = run_dir / "extract"
+    assert read_result(out / result_filename("analytic_box", "neural3d", "train")) == result
+    v, f, labels, rgb = read_semantic_ply(out / "mesh.ply")
+    assert len(f) > 1000 and set(np.unique(labels)) <= {0, 1, 2, 3}
+    poly = geojson_to_polygon(json.loads((out / "footprint.geojson").read_text()))
+    assert poly.area == pytest.approx(24.0, rel=0.01)
+
+
+def test_cli_errors_are_one_line(tmp_path, capsys):
+    assert main(["--run", str(tmp_path / "nowhere")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "does not exist" in err and "\n" not in err
+    assert main(["--run", str(tmp_path)]) == 2  # a folder that is no run
+    assert "config.json is missing" in capsys.readouterr().err
+    assert not (tmp_path / "extract").exists()
+
+
+def test_bad_config():
+    with pytest.raises(ValueError, match="resolution"):
+        ExtractConfig(resolution=4)
