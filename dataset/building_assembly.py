@@ -7,6 +7,7 @@ hold one against the other.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -17,6 +18,23 @@ from dataset.footprint import polygon_to_geojson
 from dataset.polygon_mesh import PlanarFace, triangulate_faces
 from dataset.truth import Building, BuildingTruth, BuildingType, FacadeTruth
 from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+
+
+@dataclass(frozen=True)
+class BuildingLayout:
+    """Everything a building is made of before triangulation.
+
+    ``footprint_xy`` is the (n, 2) ground outline (world x/y metres), ``walls`` the facade
+    walls, ``other_faces`` ground, roof and attached solids (balconies, chimneys).
+    """
+
+    footprint_xy: np.ndarray
+    walls: list[WallSpec]
+    other_faces: list[PlanarFace]
+    floors: int
+    height_m: float
+    curved_facade_ids: frozenset[int] = frozenset()
+    extra: dict[str, Any] = field(default_factory=dict)
 
 
 def facade_truths(
@@ -54,6 +72,19 @@ def facade_truths(
             )
         )
     return tuple(out)
+
+
+def facade_outlines_m(walls: list[WallSpec]) -> dict[str, list[list[list[float]]]]:
+    """Per facade id (as a string key, for JSON): the world-frame outline of each of its walls.
+
+    Each outline is a list of [x, y, z] corners in metres, counter-clockwise seen from outside;
+    a planar facade has one, a faceted curved facade one per facet.
+    """
+    out: dict[str, list[list[list[float]]]] = {}
+    for w in walls:
+        corners = np.round(w.frame.points_m(w.outline_uv), 9) + 0.0
+        out.setdefault(str(w.facade_id), []).append(corners.tolist())
+    return out
 
 
 def assemble_building(
@@ -97,7 +128,31 @@ def assemble_building(
         facades=facades,
         name=name,
         seed=seed,
-        extra=extra or {},
+        extra={**(extra or {}), "facade_outlines_m": facade_outlines_m(walls)},
     )
     faces = [face for w in walls for face in wall_faces(w)] + list(other_faces)
     return Building(mesh=triangulate_faces(faces), truth=truth)
+
+
+def assemble_layout(
+    layout: BuildingLayout,
+    *,
+    building_id: str,
+    building_type: BuildingType,
+    seed: int | None,
+    name: str = "",
+) -> Building:
+    """:func:`assemble_building` of a :class:`BuildingLayout`."""
+    return assemble_building(
+        building_id=building_id,
+        building_type=building_type,
+        seed=seed,
+        floors=layout.floors,
+        height_m=layout.height_m,
+        footprint_xy=layout.footprint_xy,
+        walls=layout.walls,
+        other_faces=layout.other_faces,
+        curved_facade_ids=layout.curved_facade_ids,
+        name=name,
+        extra=layout.extra,
+    )
