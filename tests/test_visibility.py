@@ -1,0 +1,60 @@
+"""dataset.visibility: ray directions, escape fractions on convex and nested boxes."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from dataset.visibility import (
+    MIN_RAY_COSINE,
+    embree_intersector,
+    escape_fractions,
+    hemisphere_directions,
+    open_to_sky,
+)
+
+
+def _normals(tri):
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def test_hemisphere_directions_are_unit_and_above_the_plane():
+    d = hemisphere_directions(64)
+    np.testing.assert_allclose(np.linalg.norm(d, axis=1), 1.0, atol=1e-12)
+    assert d[:, 2].min() >= MIN_RAY_COSINE and d[:, 2].max() <= 1.0
+    # Spread evenly in azimuth: the mean horizontal direction is near zero.
+    assert np.linalg.norm(d[:, :2].mean(axis=0)) < 0.05
+    with pytest.raises(ValueError, match="at least one"):
+        hemisphere_directions(0)
+
+
+def test_intersector_is_embree():
+    box = trimesh.creation.box()
+    assert type(embree_intersector(box.vertices, box.faces)).__module__.endswith("ray_pyembree")
+
+
+def test_convex_box_sees_everything_and_a_nested_box_nothing():
+    outer = trimesh.creation.box([10.0, 8.0, 6.0])
+    inner = trimesh.creation.box([2.0, 2.0, 2.0])
+    mesh = trimesh.util.concatenate([outer, inner])
+    tri = mesh.triangles
+    f = escape_fractions(embree_intersector(mesh.vertices, mesh.faces), tri, _normals(tri),
+                         rays_per_sample=16, offset_m=1e-3)
+    np.testing.assert_array_equal(f[: len(outer.faces)], 1.0)  # convex: every ray escapes
+    np.testing.assert_array_equal(f[len(outer.faces):], 0.0)  # enclosed: none does
+    degenerate = escape_fractions(embree_intersector(mesh.vertices, mesh.faces), tri[:1],
+                                  np.zeros((1, 3)), rays_per_sample=4, offset_m=1e-3)
+    np.testing.assert_array_equal(degenerate, 0.0)
+
+
+def test_open_to_sky():
+    box = trimesh.creation.box([2.0, 2.0, 2.0])
+    ix = embree_intersector(box.vertices + [0, 0, 5], box.faces)
+    np.testing.assert_array_equal(open_to_sky(ix, [[0, 0, 0], [3, 0, 0]]), [False, True])
+
+
+def test_bad_shapes_are_refused():
+    box = trimesh.creation.box()
+    with pytest.raises(ValueError, match=r"\(F, 3, 3\)"):
+        escape_fractions(embree_intersector(box.vertices, box.faces), np.zeros((2, 3)),
+                         np.zeros((2, 3)), rays_per_sample=4, offset_m=1e-3)
