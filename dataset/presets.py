@@ -1,0 +1,145 @@
+"""Named sets of buildings (presets) and the one entry point that builds a building from a recipe.
+
+A :class:`BuildingRecipe` names a family, a seed and, for the realistic family,
+a model; :func:`build_building` turns it into mesh + truth deterministically
+(``numpy.random.default_rng(seed)`` drives the family's sampler). Presets:
+
+- ``paper``: 12 skyscrapers, 12 L-shaped buildings and the four realistic models;
+- ``tiny``: one small building per family (a 9-storey skyscraper, a 4-storey L-shape
+  and the realistic house), cheap to render, for tests and defaults.
+
+Run ``python -m dataset.presets`` to print the ranges a preset spans.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from tqdm import tqdm
+
+from dataset.l_shaped import make_l_shaped, sample_l_shaped_params
+from dataset.realistic import REALISTIC_MODELS, make_realistic, sample_realistic_params
+from dataset.skyscraper import make_skyscraper, sample_skyscraper_params
+from dataset.truth import Building, BuildingTruth
+
+Family = Literal["skyscraper", "l_shaped", "realistic"]
+FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic")
+PRESETS = ("paper", "tiny")
+_SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
+
+# Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
+# footprints); tests/test_presets.py checks that they stay small.
+_TINY_SKYSCRAPER_SEED = 38
+_TINY_L_SHAPED_SEED = 37
+_PAPER_SEED_BASE = {"skyscraper": 1000, "l_shaped": 2000, "realistic": 3000}
+
+
+@dataclass(frozen=True)
+class BuildingRecipe:
+    """How to build one building: ``id`` (file-system safe), family, seed, realistic model."""
+
+    id: str
+    family: Family
+    seed: int
+    model: str | None = None
+
+    def __post_init__(self) -> None:
+        if not _SAFE_ID.match(self.id):
+            raise ValueError(
+                f"building id {self.id!r} is not file-system safe; "
+                "use letters, digits, '_', '-' and '.'"
+            )
+        if self.family not in FAMILIES:
+            raise ValueError(f"unknown family {self.family!r}; choose one of {', '.join(FAMILIES)}")
+        if self.family == "realistic" and self.model not in REALISTIC_MODELS:
+            raise ValueError(
+                f"a realistic recipe needs model one of {', '.join(REALISTIC_MODELS)}, "
+                f"got {self.model!r}"
+            )
+        if self.family != "realistic" and self.model is not None:
+            raise ValueError(f"only realistic recipes take a model, got model={self.model!r}")
+        if not isinstance(self.seed, int | np.integer) or self.seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
+
+
+def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
+    """The recipes of preset ``name`` (one of :data:`PRESETS`)."""
+    if name == "tiny":
+        return (
+            BuildingRecipe("tiny_skyscraper", "skyscraper", _TINY_SKYSCRAPER_SEED),
+            BuildingRecipe("tiny_l_shaped", "l_shaped", _TINY_L_SHAPED_SEED),
+            BuildingRecipe("realistic_house", "realistic", _PAPER_SEED_BASE["realistic"], "house"),
+        )
+    if name == "paper":
+        recipes = [
+            BuildingRecipe(f"{family}_{i:02d}", family, _PAPER_SEED_BASE[family] + i)
+            for family in ("skyscraper", "l_shaped")
+            for i in range(12)
+        ]
+        recipes += [
+            BuildingRecipe(f"realistic_{m}", "realistic", _PAPER_SEED_BASE["realistic"] + k, m)
+            for k, m in enumerate(REALISTIC_MODELS)
+        ]
+        return tuple(recipes)
+    raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
+
+
+def build_building(recipe: BuildingRecipe) -> Building:
+    """Mesh and exact truth of ``recipe`` (same recipe -> identical mesh and truth)."""
+    rng = np.random.default_rng(recipe.seed)
+    if recipe.family == "skyscraper":
+        params = sample_skyscraper_params(rng)
+        return make_skyscraper(params, building_id=recipe.id, seed=recipe.seed)
+    if recipe.family == "l_shaped":
+        params = sample_l_shaped_params(rng)
+        return make_l_shaped(params, building_id=recipe.id, seed=recipe.seed)
+    params = sample_realistic_params(rng, recipe.model)
+    return make_realistic(params, building_id=recipe.id, seed=recipe.seed)
+
+
+def preset_ranges(truths: list[BuildingTruth]) -> dict[str, dict[str, tuple[float, float]]]:
+    """Per family: (min, max) of floors, footprint m², height m and WWR over ``truths``."""
+    out: dict[str, dict[str, tuple[float, float]]] = {}
+    for family in sorted({t.type for t in truths}):
+        group = [t for t in truths if t.type == family]
+        out[family] = {
+            key: (min(getattr(t, attr) for t in group), max(getattr(t, attr) for t in group))
+            for key, attr in (("floors", "floors"), ("footprint_m2", "footprint_area_m2"),
+                              ("height_m", "height_m"), ("wwr", "wwr"))
+        }
+        out[family]["count"] = (len(group), len(group))
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m dataset.presets",
+        description="Build every building of a preset (no rendering) and print, per family, "
+        "how many there are and the range of floors, footprint area, height and WWR.",
+    )
+    parser.add_argument("--preset", default="paper", help=f"one of {', '.join(PRESETS)}")
+    args = parser.parse_args(argv)
+    try:
+        recipes = preset_recipes(args.preset)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    truths = [build_building(r).truth for r in tqdm(recipes, desc="building", unit="building")]
+    print(f"preset {args.preset}: {len(truths)} buildings")
+    for family, ranges in preset_ranges(truths).items():
+        f, a, h, w = (ranges[k] for k in ("floors", "footprint_m2", "height_m", "wwr"))
+        print(
+            f"  {family:<10} n={ranges['count'][0]:>2}  floors {f[0]}-{f[1]}  "
+            f"footprint {a[0]:.1f}-{a[1]:.1f} m2  height {h[0]:.1f}-{h[1]:.1f} m  "
+            f"WWR {w[0]:.3f}-{w[1]:.3f}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
