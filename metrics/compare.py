@@ -34,6 +34,7 @@ from metrics.methods import (
     debug_images_2dss,
     method_specs,
     neural3d_run_dir,
+    read_only_specs,
 )
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report import (
@@ -279,7 +280,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             data = ensure_benchmark(default)
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
-        specs = method_specs(methods, views, results, neural3d=budget)
+        if args.no_run:
+            specs = read_only_specs(methods, views)
+        else:
+            specs = method_specs(methods, views, results, neural3d=budget)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
         comparison = compare(data, specs, results, out, allow_run=not args.no_run,
                              command=f"python -m metrics.compare {argv_text}".strip())

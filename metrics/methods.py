@@ -49,12 +49,7 @@ def method_specs(
     ValueError
         If a method name or a views protocol is unknown.
     """
-    for name in names:
-        if name not in METHODS:
-            raise ValueError(f"unknown method {name!r}; choose from {', '.join(METHODS)}")
-    for view in views:
-        if view not in VIEW_PROTOCOLS:
-            raise ValueError(f"unknown views {view!r}; choose from {', '.join(VIEW_PROTOCOLS)}")
+    _check_names(names, views)
     builders = {
         "2D-S": lambda: spec_2ds(views),
         "2D-SS": lambda: spec_2dss(views),
@@ -102,31 +97,41 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
     """neural3d: time-limited training (``neural3d.train``) then extraction (``neural3d.extract``).
 
     The result's config gets a ``budget`` entry (preset, seconds, device) so a
-    result trained with another budget is recomputed.
+    result trained with another budget is recomputed. neural3d (and torch) is
+    imported only when a run is needed.
     """
-    protocols = (NEURAL3D_PROTOCOL,)
-    try:
-        # isort sees a module as first-party only once its file exists: keep this block as is.
-        from neural3d.config import preset_config  # noqa: I001
-        from neural3d.extract import ExtractConfig, extract_run
-        from neural3d.train import train
-    except ImportError as exc:
-        return _unavailable("neural3d", protocols, exc, has_footprint=True)
-    train_config = preset_config(budget.preset)
-    extract_config = ExtractConfig()
     budget_dict = {"preset": budget.preset, "max_seconds": budget.minutes * 60.0}
 
     def run(scene_dir: Path, protocol: str):
         import torch
 
+        # isort sees a module as first-party only once its file exists: keep this block as is.
+        from neural3d.config import preset_config  # noqa: I001
+        from neural3d.extract import ExtractConfig, extract_run
+        from neural3d.train import train
+
         device = torch.device(budget.device)
-        run_dir = train(scene_dir, train_config, runs_dir, device=device,
+        run_dir = train(scene_dir, preset_config(budget.preset), runs_dir, device=device,
                         max_seconds=budget.minutes * 60.0)
-        result = extract_run(run_dir, config=extract_config, device=device)
+        result = extract_run(run_dir, config=ExtractConfig(), device=device)
         return replace(result, config={**result.config, "budget": budget_dict})
 
     requested = {"budget": budget_dict}
-    return MethodSpec("neural3d", protocols, requested, run, has_footprint=True)
+    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True)
+
+
+def read_only_specs(names: tuple[str, ...], views: tuple[str, ...]) -> list[MethodSpec]:
+    """Specs for reading stored results only (``--no-run``): nothing is imported or run."""
+    _check_names(names, views)
+
+    def run(scene_dir: Path, protocol: str):
+        raise RuntimeError("read-only comparison: methods are not run")
+
+    return [
+        MethodSpec(name, (NEURAL3D_PROTOCOL,) if name == "neural3d" else views, {}, run,
+                   has_footprint=name == "neural3d")
+        for name in names
+    ]
 
 
 def neural3d_run_dir(results_dir: Path, scene: str) -> Path:
@@ -134,17 +139,26 @@ def neural3d_run_dir(results_dir: Path, scene: str) -> Path:
     return results_dir / NEURAL3D_RUNS_FOLDER / scene
 
 
+def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> None:
+    if not names:
+        raise ValueError(f"no method given; choose from {', '.join(METHODS)}")
+    for name in names:
+        if name not in METHODS:
+            raise ValueError(f"unknown method {name!r}; choose from {', '.join(METHODS)}")
+    for view in views:
+        if view not in VIEW_PROTOCOLS:
+            raise ValueError(f"unknown views {view!r}; choose from {', '.join(VIEW_PROTOCOLS)}")
+
+
 def _config_dict(config: Any) -> dict[str, Any]:
     return asdict(config) if hasattr(config, "__dataclass_fields__") else dict(config)
 
 
-def _unavailable(
-    name: str, protocols: tuple[str, ...], exc: ImportError, *, has_footprint: bool = False
-) -> MethodSpec:
+def _unavailable(name: str, protocols: tuple[str, ...], exc: ImportError) -> MethodSpec:
     reason = f"method {name} is not available: {exc}"
 
     def run(scene_dir: Path, protocol: str):
         raise RuntimeError(reason)
 
     # An empty config matches any stored result, so earlier results are still used.
-    return MethodSpec(name, protocols, {}, run, has_footprint=has_footprint)
+    return MethodSpec(name, protocols, {}, run)

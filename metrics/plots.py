@@ -28,7 +28,7 @@ def save_figure(fig: Figure, stem: str | Path) -> list[Path]:
     paths = []
     for fmt in ("png", "pdf"):
         buf = io.BytesIO()
-        fig.savefig(buf, format=fmt, dpi=PNG_DPI, bbox_inches="tight")
+        fig.savefig(buf, format=fmt, dpi=PNG_DPI)  # constrained layout: no tight bbox pass
         path = stem.with_name(f"{stem.name}.{fmt}")
         write_bytes_atomic(path, buf.getvalue())
         paths.append(path)
