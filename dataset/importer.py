@@ -9,6 +9,8 @@ footprint at ``footprint_height_m`` (:mod:`dataset.section`).
 
 from __future__ import annotations
 
+import argparse
+import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -17,10 +19,10 @@ import numpy as np
 from dataset.classes import FACADE_CLASSES, NO_FACADE, SemanticClass
 from dataset.facade_grouping import FacadeGroup, facade_ids_of_faces, group_facades
 from dataset.footprint import polygon_to_geojson
-from dataset.mesh import LabelledMesh
+from dataset.mesh import LabelledMesh, write_labelled_ply
 from dataset.mesh_files import UpAxis, read_labelled_mesh_file
 from dataset.section import cross_section_footprint
-from dataset.truth import Building, BuildingTruth, FacadeTruth
+from dataset.truth import Building, BuildingTruth, FacadeTruth, write_building
 from dataset.visibility import embree_intersector, escape_fractions
 from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
 
@@ -52,7 +54,7 @@ class ImportConfig:
     """A face is seen from outside if at least this fraction of its rays escape."""
     ray_offset_m: float = 1e-3
     """Rays start this far off the surface (embree works in float32)."""
-    footprint_height_m: float = 0.5
+    footprint_height_m: float = 0.05
     """The footprint is the cross-section this far above the mesh's lowest point."""
     floor_height_m: float = 3.0
     """Storey height: floors = round(height / floor_height_m), at least 1."""
@@ -95,7 +97,8 @@ def import_labelled_mesh(
 
     Returns
     -------
-    Building whose mesh has merged vertices, the file's face order and facade ids 1..N, and
+    Building whose mesh has merged vertices, the file's face order (less faces collapsed to a
+    line or point by the merge) and facade ids 1..N, and
     whose truth (type ``"imported"``) counts only faces seen from outside.
 
     Raises
@@ -105,7 +108,7 @@ def import_labelled_mesh(
         oriented, no facade classes, or no facade seen from outside.
     """
     path = Path(path)
-    mesh = read_labelled_mesh_file(path, up_axis=config.up_axis)
+    mesh = _drop_collapsed_faces(read_labelled_mesh_file(path, up_axis=config.up_axis))
     _check_mesh(path, mesh)
     vertices, faces, offset = mesh.vertices_m, mesh.faces, np.zeros(3)
     if config.recentre:
@@ -179,6 +182,15 @@ def import_labelled_mesh(
     return Building(mesh=mesh, truth=truth)
 
 
+def _drop_collapsed_faces(mesh: LabelledMesh) -> LabelledMesh:
+    """Without faces that merging made a line or a point (zero area, and their edges pair up)."""
+    f = mesh.faces
+    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 2] != f[:, 0])
+    if keep.all():
+        return mesh
+    return LabelledMesh(mesh.vertices_m, f[keep], mesh.face_label[keep], mesh.face_facade[keep])
+
+
 def _check_mesh(path: Path, mesh: LabelledMesh) -> None:
     if len(mesh.faces) == 0:
         raise ValueError(f"{path} holds no faces; export the building's surfaces as triangles")
@@ -247,3 +259,49 @@ def _class_areas(mesh: LabelledMesh, areas: np.ndarray, keep: np.ndarray) -> dic
     return {
         c.name.lower(): float(areas[keep & (mesh.face_label == c)].sum()) for c in FACADE_CLASSES
     }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m dataset.importer",
+        description="Import your own labelled building mesh: derive its ground truth (facades, "
+        "window/wall/door areas seen from outside, WWR, footprint) and write building.json and "
+        "mesh.ply (with facade ids) into a scene folder. The mesh must be closed; label faces "
+        "with a PLY 'label' property (0 background, 1 wall, 2 window, 3 roof, 4 door, 5 other) "
+        "or name OBJ/GLB objects, groups or materials after the classes.",
+    )
+    parser.add_argument("mesh", type=Path, help="labelled mesh: .ply, .obj, .glb or .gltf")
+    parser.add_argument("scene_dir", type=Path, help="folder to write building.json and mesh.ply")
+    parser.add_argument("--id", dest="building_id", help="building id (default: file name)")
+    defaults = ImportConfig()
+    parser.add_argument("--up-axis", choices=("z", "y"), default=defaults.up_axis,
+                        help="the file's up axis; glTF from Blender is y (default: %(default)s)")
+    parser.add_argument("--footprint-height-m", type=float, default=defaults.footprint_height_m,
+                        help="footprint section height above the lowest point "
+                        "(default: %(default)s)")
+    parser.add_argument("--floor-height-m", type=float, default=defaults.floor_height_m,
+                        help="storey height for the floor count (default: %(default)s)")
+    parser.add_argument("--keep-position", action="store_true",
+                        help="keep the file's coordinates instead of centring the building "
+                        "on the origin with its lowest point at z = 0")
+    args = parser.parse_args(argv)
+    try:
+        config = ImportConfig(
+            up_axis=args.up_axis, recentre=not args.keep_position,
+            footprint_height_m=args.footprint_height_m, floor_height_m=args.floor_height_m,
+        )
+        building = import_labelled_mesh(args.mesh, building_id=args.building_id, config=config)
+        write_labelled_ply(args.scene_dir / "mesh.ply", building.mesh)
+        write_building(args.scene_dir / "building.json", building.truth)  # last: marks done
+    except (ValueError, OSError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    t = building.truth
+    print(f"{t.id}: {len(t.facades)} facades, facade {t.facade_area_m2:.2f} m2, window "
+          f"{t.window_area_m2:.2f} m2, WWR {t.wwr:.4f}, footprint {t.footprint_area_m2:.2f} m2 "
+          f"-> {args.scene_dir}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -23,6 +23,7 @@ from dataset.examples.make_example_bim import (
 from dataset.footprint import geojson_to_polygon
 from dataset.importer import ImportConfig, import_labelled_mesh
 from dataset.mesh import LabelledMesh, write_labelled_ply
+from dataset.presets import build_building, preset_recipes
 
 REL = 1e-6
 EXAMPLES = Path(__file__).resolve().parents[1] / "dataset" / "examples"
@@ -252,3 +253,22 @@ def test_missing_file_and_bad_config_are_refused(tmp_path):
         ImportConfig(min_escape_fraction=0.0)
     with pytest.raises(ValueError, match="up_axis"):
         ImportConfig(up_axis="x")
+
+
+def test_agrees_with_the_generators_exact_truth(tmp_path):
+    # The benchmark's own L-shaped building, labels only: the importer re-derives its truth.
+    recipe = next(r for r in preset_recipes("tiny") if r.family == "l_shaped")
+    generated = build_building(recipe)
+    m = generated.mesh
+    write_labelled_ply(tmp_path / "g.ply", LabelledMesh(m.vertices_m, m.faces, m.face_label,
+                                                        np.zeros(len(m.faces))))
+    t = import_labelled_mesh(tmp_path / "g.ply", config=ImportConfig(recentre=False)).truth
+    g = generated.truth
+    assert len(t.facades) == len(g.facades) == 6
+    for key in ("window_area_m2", "wall_area_m2", "door_area_m2", "facade_area_m2"):
+        assert getattr(t, key) == pytest.approx(getattr(g, key), rel=REL)
+    for f in g.facades:  # match facades by outward normal and width
+        mine = max(t.facades, key=lambda h: np.dot(h.normal, f.normal) - abs(h.width_m - f.width_m))
+        assert mine.window_area_m2 == pytest.approx(f.window_area_m2, rel=REL, abs=1e-9)
+        assert mine.facade_area_m2 == pytest.approx(f.facade_area_m2, rel=REL)
+    assert _iou(geojson_to_polygon(t.footprint), geojson_to_polygon(g.footprint)) >= 0.999
