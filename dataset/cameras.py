@@ -255,8 +255,11 @@ def multi_views(
         top = max(config.eye_height_m, float(patch.centre_m[2]))
         for k, slot in enumerate(slots):
             pose, problem = None, ""
-            for _ in range(config.max_attempts):
-                azimuth = slot + rng.uniform(-jitter, jitter)
+            for attempt in range(config.max_attempts):
+                # Near its slot first; then anywhere in the range (an L-shape's inner
+                # facade is hidden by the other wing on one side).
+                azimuth = (slot + rng.uniform(-jitter, jitter) if attempt < config.max_attempts // 3
+                           else rng.uniform(-spread, spread))
                 eye_z = rng.uniform(config.eye_height_m, top)
                 distance = base * rng.uniform(*config.multi_distance_factor)
                 pose, problem = _multi_pose(

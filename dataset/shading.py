@@ -128,24 +128,36 @@ def sample_look(seed: int, config: RgbConfig = RgbConfig()) -> Look:
 def environment_radiance(dirs_unit: np.ndarray, look: Look, *, sun_disc: bool = True) -> np.ndarray:
     """Linear radiance (N, 3) of the environment map seen along unit directions (N, 3)."""
     d = np.asarray(dirs_unit, dtype=np.float64)
+    out = np.empty((len(d), 3))
     up = d[:, 2]
-    elev = np.clip(up, 0.0, 1.0)[:, None]
-    sky = look.sky_horizon_rgb + (look.sky_zenith_rgb - look.sky_horizon_rgb) * elev**0.45
-    cos_sun = np.clip(d @ look.sun_dir, 0.0, 1.0)[:, None]
-    sky = sky + 0.12 * look.sun_rgb * cos_sun**8 + 0.3 * look.sun_rgb * cos_sun**256
+    sky = up >= 0
+    ds = d[sky]
+    elev = np.sqrt(np.sqrt(ds[:, 2:3]))  # ~ elevation**0.45 without a general power
+    radiance = look.sky_horizon_rgb + (look.sky_zenith_rgb - look.sky_horizon_rgb) * elev
+    cos_sun = np.clip(ds @ look.sun_dir, 0.0, 1.0)
+    glow = cos_sun**2
+    glow = glow * glow
+    glow = glow * glow  # cos**8
+    halo = np.where(cos_sun > 0.97, cos_sun, 0.0)
+    for _ in range(8):  # cos**256 by squaring: np.power is slow on large arrays
+        halo = halo * halo
+    radiance += (0.12 * glow + 0.3 * halo)[:, None] * look.sun_rgb
     if sun_disc:
-        sky = sky + 40.0 * look.sun_rgb * (cos_sun > np.cos(np.deg2rad(0.6)))
+        radiance += (40.0 * (cos_sun > np.cos(np.deg2rad(0.6))))[:, None] * look.sun_rgb
+    out[sky] = radiance
     # Ground tones: a texture on an imagined plane 10 m below, fading into haze.
-    down = np.maximum(-up, 1e-3)
-    gx, gy = 10.0 * d[:, 0] / down, 10.0 * d[:, 1] / down
+    dg = d[~sky]
+    down = np.maximum(-dg[:, 2], 1e-3)
+    gx, gy = 10.0 * dg[:, 0] / down, 10.0 * dg[:, 1] / down
     tone = 0.8 + 0.4 * value_noise(gx / 4.0, gy / 4.0, look.texture_seed + 7)
     tone *= 0.9 + 0.2 * value_noise(gx / 0.5, gy / 0.5, look.texture_seed + 8)
     sky_mean = 0.5 * (look.sky_zenith_rgb + look.sky_horizon_rgb)
     ground_light = look.sun_rgb * look.sun_dir[2] + sky_mean
-    ground = look.ground_rgb * ground_light * tone[:, None]
     haze = np.exp(-12.0 * down)[:, None]
-    ground = ground * (1 - haze) + 0.8 * look.sky_horizon_rgb * haze
-    return np.where((up >= 0)[:, None], sky, ground)
+    out[~sky] = (look.ground_rgb * ground_light) * (tone[:, None] * (1 - haze)) + (
+        0.8 * look.sky_horizon_rgb * haze
+    )
+    return out
 
 
 def shade(
@@ -173,8 +185,10 @@ def shade(
     """
     look = sample_look(seed, config)
     d_unit = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)
-    out = environment_radiance(d_unit, look)
-    hit = np.flatnonzero(face >= 0)
+    out = np.empty((len(dirs), 3))
+    miss = face < 0
+    out[miss] = environment_radiance(d_unit[miss], look)
+    hit = np.flatnonzero(~miss)
     if len(hit) == 0:
         return out
     f = face[hit]

@@ -16,12 +16,16 @@ folders (one per building, named by building id).
 
 from __future__ import annotations
 
+import warnings
+from pathlib import Path
+
 import numpy as np
 import pytest
 from shapely.geometry import box as shapely_box
 
 from dataset.classes import NO_FACADE, SemanticClass
 from dataset.footprint import polygon_to_geojson
+from dataset.generate import GenerateConfig, generate_preset
 from dataset.mesh import LabelledMesh, concatenate_meshes
 from dataset.truth import Building, BuildingTruth, FacadeTruth
 from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
@@ -119,3 +123,18 @@ def make_box_building() -> Building:
 def box_building() -> Building:
     """A labelled box building with exact truth (see the module docstring)."""
     return make_box_building()
+
+
+TINY_CONFIG = GenerateConfig(resolution=96, views=16)
+"""Tiny benchmark: 96 px images, 16 orbit views (8 train, 8 eval), ideal and multi views."""
+
+
+@pytest.fixture(scope="session")
+def tiny_benchmark(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Folder holding the ``tiny`` preset's scene folders, generated once per session."""
+    root = tmp_path_factory.mktemp("tiny_benchmark")
+    with warnings.catch_warnings():
+        # An occluded facade view is dropped with a warning; tests see the result, not the noise.
+        warnings.simplefilter("ignore", UserWarning)
+        generate_preset("tiny", root, TINY_CONFIG, progress=False)
+    return root
