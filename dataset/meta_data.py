@@ -151,6 +151,21 @@ def remap_labels(labels: np.ndarray, mapping: ClassMapping) -> np.ndarray:
     return lut[a]
 
 
+def read_remapped_labels(path: str | Path, mapping: ClassMapping) -> np.ndarray:
+    """(H, W) uint8 our class ids of a source's segmentation PNG (ids or colour-coded).
+
+    Single-channel (and palette) images hold ids; RGB(A) images are colour-coded masks.
+    """
+    from PIL import Image
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"segmentation image {path} does not exist")
+    with Image.open(path) as img:
+        labels = np.asarray(img.convert("RGB") if img.mode == "RGBA" else img)
+    return remap_labels(labels, mapping)
+
+
 def read_meta_data(
     path: str | Path,
     *,

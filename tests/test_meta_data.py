@@ -14,6 +14,7 @@ from dataset.meta_data import (
     class_mapping,
     opencv_from_opengl,
     read_meta_data,
+    read_remapped_labels,
     remap_labels,
     write_meta_data,
 )
@@ -150,6 +151,21 @@ def test_remap_colour_coded_masks():
         remap_labels(np.full((1, 1, 3), 7, np.uint8), renderer)
     with pytest.raises(ValueError, match="no mask colours"):
         remap_labels(colours, class_mapping("envelope_bench"))
+
+
+def test_read_remapped_labels_from_id_and_colour_pngs(tmp_path):
+    from PIL import Image
+
+    renderer = class_mapping("renderer")
+    ids = np.array([[0, 1], [2, 3]], dtype=np.uint8)
+    Image.fromarray(ids).save(tmp_path / "ids.png")
+    colours = np.array(renderer.colours, dtype=np.uint8)[ids]
+    Image.fromarray(colours).save(tmp_path / "rgb.png")
+    expected = [[0, 1], [4, 2]]
+    np.testing.assert_array_equal(read_remapped_labels(tmp_path / "ids.png", renderer), expected)
+    np.testing.assert_array_equal(read_remapped_labels(tmp_path / "rgb.png", renderer), expected)
+    with pytest.raises(ValueError, match="does not exist"):
+        read_remapped_labels(tmp_path / "none.png", renderer)
 
 
 def test_bad_input_messages(tmp_path):
