@@ -97,9 +97,9 @@ def import_labelled_mesh(
 
     Returns
     -------
-    Building whose mesh has merged vertices, the file's face order (less faces collapsed to a
-    line or point by the merge) and facade ids 1..N, and
-    whose truth (type ``"imported"``) counts only faces seen from outside.
+    Building whose mesh has merged vertices, the file's face order (less faces the merge
+    collapsed to a line) and facade ids 1..N, and whose truth (type ``"imported"``) counts
+    only faces seen from outside.
 
     Raises
     ------
