@@ -233,11 +233,12 @@ def write_meta_data(
 
     ``path`` is the file, or an existing folder to write ``meta_data.json`` into. Poses go
     out in ``layout.pose_convention``; intrinsics as 4x4. ``scene_box`` and ``worldtogt``
-    come from ``scene.extra`` when present, else ``worldtogt`` is the identity and the
-    box is the cameras' bounding box (``near`` 0.05 m, ``far`` its diagonal, collider
-    ``near_far``). Labels are written as they are: read back with
-    ``class_ids="envelope_bench"``. Our ``split``, ``facade_id`` and normal/instance
-    paths are kept as extra frame keys, which sdfstudio ignores.
+    come from ``scene.extra`` when present; missing entries default to the identity and
+    to a box around the building (footprint x/y, 0 to its height, 10 % margin) or else
+    around the cameras, ``near`` 0.05 m, ``far`` the cameras' extent, collider
+    ``near_far``. Labels are written as they are: read back with
+    ``class_ids="envelope_bench"``. Our ``split``, ``facade_id`` and normal/instance paths
+    are kept as extra frame keys, which sdfstudio ignores.
 
     Raises
     ------
@@ -256,26 +257,40 @@ def write_meta_data(
     (width, height), = sizes
     centres = np.array([np.asarray(f.world_from_camera)[:3, 3] for f in scene.frames])
     diagonal = float(np.linalg.norm(centres.max(axis=0) - centres.min(axis=0))) or 1.0
+    scene_box = {
+        "aabb": _scene_aabb(scene, centres),
+        "near": 0.05,
+        "far": diagonal,
+        "radius": diagonal / 2,
+        "collider_type": "near_far",
+        **scene.extra.get("scene_box", {}),  # BuildNet3D's boxes have only an aabb
+    }
     meta: dict[str, Any] = {
         "camera_model": "OPENCV",
         "height": height,
         "width": width,
         "has_mono_prior": False,
         "worldtogt": np.eye(4).tolist(),
-        "scene_box": {
-            "aabb": [centres.min(axis=0).tolist(), centres.max(axis=0).tolist()],
-            "near": 0.05,
-            "far": diagonal,
-            "radius": diagonal / 2,
-            "collider_type": "near_far",
-        },
         **scene.extra,
+        "scene_box": scene_box,
         "depth_unit_scale_factor": scene.depth_unit_scale_factor,
         "semantic_classes": list(scene.semantic_classes),
         "frames": [_frame_to_json(f, layout) for f in scene.frames],
     }
     path = Path(path)
     write_json_atomic(path / META_DATA_FILE if path.is_dir() else path, meta)
+
+
+def _scene_aabb(scene: Scene, camera_centres_m: np.ndarray) -> list[list[float]]:
+    """[[x, y, z] min, max] around the building if the scene has its truth, else the cameras."""
+    if scene.building is None:
+        return [camera_centres_m.min(axis=0).tolist(), camera_centres_m.max(axis=0).tolist()]
+    from dataset.footprint import geojson_to_polygon
+
+    x0, y0, x1, y1 = geojson_to_polygon(scene.building.footprint).bounds
+    lo, hi = np.array([x0, y0, 0.0]), np.array([x1, y1, scene.building.height_m])
+    margin = 0.1 * np.linalg.norm(hi - lo)
+    return [(lo - margin).tolist(), (hi + margin).tolist()]
 
 
 def opencv_from_opengl(world_from_camera: np.ndarray) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -151,6 +152,23 @@ def test_remap_colour_coded_masks():
         remap_labels(np.full((1, 1, 3), 7, np.uint8), renderer)
     with pytest.raises(ValueError, match="no mask colours"):
         remap_labels(colours, class_mapping("envelope_bench"))
+
+
+def test_scene_box_around_the_building_and_partial_boxes_completed(tmp_path):
+    from dataset.importer import import_labelled_mesh
+
+    example = Path(__file__).resolve().parents[1] / "dataset" / "examples" / "example_bim.ply"
+    truth = import_labelled_mesh(example).truth
+    write_meta_data(replace(_scene(tmp_path), building=truth), tmp_path)
+    box = json.loads((tmp_path / "meta_data.json").read_text())["scene_box"]
+    margin = 0.1 * np.linalg.norm([12.0, 8.0, 6.3])
+    np.testing.assert_allclose(box["aabb"], [[-6 - margin, -4 - margin, -margin],
+                                             [6 + margin, 4 + margin, 6.3 + margin]], atol=1e-9)
+    partial = replace(_scene(tmp_path), extra={"scene_box": {"aabb": [[-1, -1, -1], [1, 1, 1]]}})
+    write_meta_data(partial, tmp_path)
+    box = json.loads((tmp_path / "meta_data.json").read_text())["scene_box"]
+    assert box["aabb"] == [[-1, -1, -1], [1, 1, 1]]
+    assert {"near", "far", "radius", "collider_type"} <= set(box)
 
 
 def test_read_remapped_labels_from_id_and_colour_pngs(tmp_path):
