@@ -25,6 +25,7 @@ FACET_TARGET_M = 1.8
 PARAPET_THICKNESS_M = 0.3
 STRAIGHT_BAY_M = 3.6
 CURVED_FACADE_ID = 2
+MIN_STRAIGHT_M = 2.0
 
 
 def rounded_footprint(width_m: float, depth_m: float) -> tuple[np.ndarray, int]:
@@ -35,9 +36,10 @@ def rounded_footprint(width_m: float, depth_m: float) -> tuple[np.ndarray, int]:
     """
     r = depth_m / 2
     xc = width_m / 2 - r
-    if xc <= -width_m / 2 + 2.0:
+    if xc - (-width_m / 2) < MIN_STRAIGHT_M:
         raise ValueError(
-            f"rounded model needs width > depth + 2 m (a straight part), got {width_m} x {depth_m}"
+            f"rounded model needs width >= depth / 2 + {MIN_STRAIGHT_M} m (a straight part), "
+            f"got {width_m} x {depth_m}"
         )
     facets = max(6, round(np.pi * r / FACET_TARGET_M))
     angles = -np.pi / 2 + np.pi * np.arange(1, facets) / facets

@@ -1,0 +1,38 @@
+"""The house: gable walls in closed form, the chimney as its own closed body."""
+
+import pytest
+from building_checks import check_closed_bodies
+
+from dataset.classes import SemanticClass
+from dataset.realistic import RealisticParams, make_realistic
+from dataset.realistic_house import CHIMNEY_ABOVE_RIDGE_M, house_layout
+
+
+def test_house_facades_and_roof_are_closed_form():
+    p = RealisticParams("house", width_m=12.0, depth_m=9.0, floors=3, floor_height_m=3.0,
+                        roof_m=5.0)
+    t = make_realistic(p).truth
+    eave, rise = 9.0, 5.0
+    assert t.height_m == pytest.approx(eave + rise)
+    south, east, north, west = t.facades
+    assert south.facade_area_m2 == pytest.approx(12.0 * eave)
+    assert east.facade_area_m2 == pytest.approx(9.0 * eave + 9.0 * rise / 2)
+    assert east.height_m == pytest.approx(eave + rise)
+    assert south.door_area_m2 == north.door_area_m2 == pytest.approx(1.1 * 2.2)
+    # Three window sizes: large ground floor, typical, small (back ground floor and attic).
+    sizes = {round(o.area_m2, 6) for w in house_layout(p).walls for o in w.openings
+             if o.kind == "window"}
+    assert len(sizes) >= 3
+    assert t.extra["roof"]["kind"] == "gable"
+    assert t.extra["chimney_top_m"] == pytest.approx(eave + rise + CHIMNEY_ABOVE_RIDGE_M)
+
+
+def test_chimney_is_a_separate_closed_body_above_the_ridge():
+    building = make_realistic(RealisticParams("house"))
+    assert check_closed_bodies(building) == 2
+    mesh = building.mesh
+    other = mesh.face_label == SemanticClass.OTHER
+    top = mesh.triangles_m[other][..., 2].max()
+    assert top == pytest.approx(building.truth.height_m + CHIMNEY_ABOVE_RIDGE_M)
+    roof = mesh.face_label == SemanticClass.ROOF
+    assert mesh.triangles_m[roof][..., 2].max() == pytest.approx(building.truth.height_m)
