@@ -78,7 +78,7 @@ def fit_plane_ransac(
         raise ValueError(f"RANSAC needs at least 3 points of shape (N, 3), got {p.shape}")
     if threshold_m <= 0 or iterations < 1:
         raise ValueError("threshold_m must be > 0 and iterations >= 1")
-    idx = np.stack([rng.choice(len(p), 3, replace=False) for _ in range(iterations)])
+    idx = rng.integers(0, len(p), (iterations, 3))  # repeated indices give a zero normal
     a, b, c = p[idx[:, 0]], p[idx[:, 1]], p[idx[:, 2]]
     normals = np.cross(b - a, c - a)
     norms = np.linalg.norm(normals, axis=1)
