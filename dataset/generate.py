@@ -45,7 +45,7 @@ from dataset.images import (
     write_rgb,
 )
 from dataset.mesh import write_labelled_ply
-from dataset.render import Raycaster, render_ground_truth, render_rgb
+from dataset.render import Raycaster, render_view
 from dataset.results import code_version
 from dataset.scene import Frame, Scene, Split, write_transforms
 from dataset.shading import RgbConfig
@@ -269,9 +269,8 @@ def _render_view(
     tmp: Path, raycaster: Raycaster, k: Intrinsics, view: PlannedView, config: GenerateConfig,
     seed: int, unit: float,
 ) -> Frame:
-    gt = render_ground_truth(raycaster, k, view.world_from_camera)
-    rgb = render_rgb(raycaster, k, view.world_from_camera, config=config.rgb, seed=seed,
-                     supersampling=config.supersampling)
+    gt, rgb = render_view(raycaster, k, view.world_from_camera, config=config.rgb, seed=seed,
+                          supersampling=config.supersampling)
     paths = {folder: f"{folder}/{view.name}.png"
              for folder in ("images", "depth", "semantics", "normals", "instances")}
     write_rgb(tmp / paths["images"], rgb)
@@ -318,6 +317,10 @@ def _init_worker() -> None:
 
 def _exit_on_sigterm(signum: int, frame: Any) -> None:
     raise SystemExit(128 + signum)  # unwinds atomic_directory, which removes the partial folder
+
+
+def _interrupt_on_sigterm(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
 
 
 def _remove_stale_partials(out_root: Path, name: str) -> None:
@@ -381,6 +384,8 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
 def main(argv: list[str] | None = None) -> int:
     """CLI entry point; returns the exit code (0 ok, 2 bad input, 130 interrupted)."""
     args = _parse_args(argv)
+    # `kill` (SIGTERM) stops the run as cleanly as Ctrl-C does.
+    previous = signal.signal(signal.SIGTERM, _interrupt_on_sigterm)
     try:
         config = GenerateConfig(
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
@@ -402,6 +407,8 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     for scene in scenes:
         print(scene)
     return 0

@@ -25,6 +25,7 @@ __all__ = [
     "RgbConfig",
     "render_ground_truth",
     "render_rgb",
+    "render_view",
 ]
 
 # Below this |n . d| a ray grazes its triangle's plane and the plane solve is
@@ -197,12 +198,29 @@ def render_rgb(
     views of a building so they agree. ``supersampling`` s renders s x s rays per
     pixel and averages them (anti-aliasing); labels and depth are never supersampled.
     """
+    return render_view(mesh, intrinsics, world_from_camera, config=config, seed=seed,
+                       supersampling=supersampling)[1]
+
+
+def render_view(
+    mesh: LabelledMesh | Raycaster,
+    intrinsics: Intrinsics,
+    world_from_camera: np.ndarray,
+    *,
+    config: RgbConfig | None = None,
+    seed: int = 0,
+    supersampling: int = 1,
+) -> tuple[GroundTruthImages, np.ndarray]:
+    """Ground truth and RGB of one view, as :func:`render_ground_truth` and :func:`render_rgb`
+    give them, casting the primary rays once when ``supersampling`` is 1."""
     if not isinstance(supersampling, int | np.integer) or supersampling < 1:
         raise ValueError(f"supersampling must be an integer >= 1, got {supersampling!r}")
     config = RgbConfig() if config is None else config
     s = int(supersampling)
     fine = intrinsics.scaled(s) if s > 1 else intrinsics
     hits = _cast_view(mesh, fine, world_from_camera)
+    truth = hits.images if s == 1 else render_ground_truth(hits.raycaster, intrinsics,
+                                                            world_from_camera)
     rgb_linear = shade(
         hits.raycaster,
         origins_m=hits.origins_m,
@@ -216,7 +234,7 @@ def render_rgb(
     if s > 1:
         h, w = intrinsics.height, intrinsics.width
         rgb_linear = rgb_linear[: h * s, : w * s].reshape(h, s, w, s, 3).mean(axis=(1, 3))
-    return _to_srgb8(rgb_linear, config.exposure)
+    return truth, _to_srgb8(rgb_linear, config.exposure)
 
 
 @dataclass(frozen=True)

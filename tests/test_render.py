@@ -9,7 +9,7 @@ import trimesh
 from dataset.camera import Intrinsics, look_at, pixel_centres, rays_world, unproject_depth_to_world
 from dataset.classes import SemanticClass
 from dataset.mesh import LabelledMesh, concatenate_meshes
-from dataset.render import Raycaster, RgbConfig, render_ground_truth, render_rgb
+from dataset.render import Raycaster, RgbConfig, render_ground_truth, render_rgb, render_view
 from dataset.shading import sample_look
 
 K = Intrinsics.from_fov(160, 120, 60.0)
@@ -132,6 +132,16 @@ def test_rgb_is_deterministic_and_varies_with_seed(box_raycaster):
     fine = render_rgb(box_raycaster, K, POSE, seed=3, supersampling=2)
     assert fine.shape == a.shape
     assert 0 < np.abs(fine.astype(int) - a.astype(int)).mean() < 20  # only edges and texture
+
+
+def test_render_view_matches_the_separate_renders(box_raycaster):
+    for s in (1, 2):
+        gt, rgb = render_view(box_raycaster, K, POSE, seed=2, supersampling=s)
+        np.testing.assert_array_equal(rgb, render_rgb(box_raycaster, K, POSE, seed=2,
+                                                      supersampling=s))
+        alone = render_ground_truth(box_raycaster, K, POSE)
+        np.testing.assert_array_equal(gt.depth_z_m, alone.depth_z_m)
+        np.testing.assert_array_equal(gt.facade_ids, alone.facade_ids)
 
 
 def test_rgb_sky_above_ground_below(box_raycaster):
