@@ -33,7 +33,7 @@ from metrics.methods import (
     Neural3dBudget,
     debug_images_2dss,
     method_specs,
-    neural3d_run_dir,
+    neural3d_extract_dir,
     read_only_specs,
 )
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
@@ -188,13 +188,13 @@ def _write_footprints(outcomes: Sequence[Outcome], folder: Path) -> None:
 def _write_neural3d_pointers(scene_dirs: Sequence[Path], results_dir: Path, out: Path) -> None:
     runs = []
     for scene_dir in scene_dirs:
-        run_dir = neural3d_run_dir(results_dir, scene_dir.name)
-        if (run_dir / "mesh.ply").is_file():
-            footprint = run_dir / "footprint.geojson"
+        extract_dir = neural3d_extract_dir(results_dir, scene_dir.name)
+        if (extract_dir / "mesh.ply").is_file():
+            footprint = extract_dir / "footprint.geojson"
             runs.append({
                 "scene": scene_dir.name,
-                "run_dir": str(run_dir.resolve()),
-                "mesh": str((run_dir / "mesh.ply").resolve()),
+                "run_dir": str(extract_dir.parent.resolve()),
+                "mesh": str((extract_dir / "mesh.ply").resolve()),
                 "footprint": str(footprint.resolve()) if footprint.is_file() else None,
             })
     write_json_atomic(out / NEURAL3D_POINTERS_FILE, {"runs": runs})

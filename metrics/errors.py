@@ -23,6 +23,7 @@ from dataset.truth import BuildingTruth
 Status = Literal["ok", "failed"]
 NO_TRUTH_FAMILY = "unknown"  # family of a scene without building.json (a user's photos)
 FACADE_PROTOCOLS = ("ideal", "multi")  # protocols whose facade ids are the truth's ids
+UNMATCHED_FACADES_WARNING = "no truth mesh matched"  # neural3d's note when ids are its own
 
 
 def absolute_percentage_error(estimate: float, truth: float) -> float:
@@ -165,12 +166,14 @@ def building_errors(result: MethodResult, truth: BuildingTruth | None) -> Buildi
 
 
 def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[FacadeErrors, ...]:
-    """Per-facade errors, for protocols whose facade ids are the truth's (ideal, multi).
+    """Per-facade errors of a result whose facade ids are the truth's ids.
 
-    Other protocols (neural3d's ``train``) number facades their own way, so
-    their facades cannot be matched to the truth and give no rows.
+    They are for the ideal and multi protocols (each view carries its facade
+    id) and for a result whose config says ``match_truth_facades`` (neural3d
+    numbers its facades after the truth facade each faces) unless its warnings
+    say no truth was matched. Other results give no rows.
     """
-    if truth is None or result.protocol not in FACADE_PROTOCOLS:
+    if truth is None or not facade_ids_are_truth_ids(result):
         return ()
     true_by_id = {f.id: f for f in truth.facades}
     rows = []
@@ -191,6 +194,15 @@ def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[Fa
                 wwr_ape=wwr_ape, window_ape=window_ape, facade_ape=facade_ape,
             ))
     return tuple(rows)
+
+
+def facade_ids_are_truth_ids(result: MethodResult) -> bool:
+    """Whether the result's facade ids are the truth's (see :func:`facade_errors`)."""
+    if result.protocol in FACADE_PROTOCOLS:
+        return True
+    return result.config.get("match_truth_facades") is True and not any(
+        UNMATCHED_FACADES_WARNING in w for w in result.warnings
+    )
 
 
 def _ape_or_none(

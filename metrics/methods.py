@@ -20,6 +20,7 @@ METHODS: tuple[str, ...] = ("2D-S", "2D-SS", "neural3d")
 VIEW_PROTOCOLS: tuple[str, ...] = ("ideal", "multi")
 NEURAL3D_PROTOCOL = "train"
 NEURAL3D_RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
+NEURAL3D_EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
 
 
 @dataclass(frozen=True)
@@ -96,28 +97,33 @@ def debug_images_2dss(scene_dir: Path, protocol: str, debug_dir: Path) -> None:
 def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
     """neural3d: time-limited training (``neural3d.train``) then extraction (``neural3d.extract``).
 
-    The result's config gets a ``budget`` entry (preset, seconds, device) so a
-    result trained with another budget is recomputed. neural3d (and torch) is
-    imported only when a run is needed.
+    The result's config (the extraction config) gets the training config and a
+    ``budget`` entry (preset, seconds), so a result trained otherwise is
+    recomputed. Training (and torch) is imported only when a run is needed.
     """
-    budget_dict = {"preset": budget.preset, "max_seconds": budget.minutes * 60.0}
+    from neural3d.config import config_to_dict, preset_config
+
+    train_config = preset_config(budget.preset)
+    extra = {
+        "budget": {"preset": budget.preset, "max_seconds": budget.minutes * 60.0},
+        "train": config_to_dict(train_config),
+    }
 
     def run(scene_dir: Path, protocol: str):
         import torch
 
         # isort sees a module as first-party only once its file exists: keep this block as is.
-        from neural3d.config import preset_config  # noqa: I001
-        from neural3d.extract import ExtractConfig, extract_run
+        from neural3d.extract import ExtractConfig, extract_run  # noqa: I001
         from neural3d.train import train
 
         device = torch.device(budget.device)
-        run_dir = train(scene_dir, preset_config(budget.preset), runs_dir, device=device,
+        run_dir = train(scene_dir, train_config, runs_dir, device=device,
                         max_seconds=budget.minutes * 60.0)
-        result = extract_run(run_dir, config=ExtractConfig(), device=device)
-        return replace(result, config={**result.config, "budget": budget_dict})
+        result = extract_run(run_dir, config=ExtractConfig(), device=device,
+                             out_dir=run_dir / NEURAL3D_EXTRACT_FOLDER)
+        return replace(result, config={**result.config, **extra})
 
-    requested = {"budget": budget_dict}
-    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True)
+    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), extra, run, has_footprint=True)
 
 
 def read_only_specs(names: tuple[str, ...], views: tuple[str, ...]) -> list[MethodSpec]:
@@ -134,9 +140,9 @@ def read_only_specs(names: tuple[str, ...], views: tuple[str, ...]) -> list[Meth
     ]
 
 
-def neural3d_run_dir(results_dir: Path, scene: str) -> Path:
-    """The run folder neural3d trains a scene into (mesh.ply and footprint.geojson live there)."""
-    return results_dir / NEURAL3D_RUNS_FOLDER / scene
+def neural3d_extract_dir(results_dir: Path, scene: str) -> Path:
+    """Where neural3d's mesh.ply and footprint.geojson of a scene are (inside its run folder)."""
+    return results_dir / NEURAL3D_RUNS_FOLDER / scene / NEURAL3D_EXTRACT_FOLDER
 
 
 def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> None:

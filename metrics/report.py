@@ -59,7 +59,7 @@ def table3_footprint_iou(
             (g.family, g.method, g.protocol, g.buildings, g.failed, g.footprint_iou)
             for g in kept
         ),
-        notes=_failure_notes(kept),
+        notes=_failure_notes(kept) or (() if kept else ("no method estimates a footprint",)),
         decimals=3,
     )
 

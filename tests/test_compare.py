@@ -133,3 +133,25 @@ def test_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys, args, message):
     assert err.startswith("error: ") and message in err and "Traceback" not in err
     assert err.count("\n") == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_runs_the_2d_methods_on_the_tiny_benchmark_then_reuses_them(tiny_benchmark, tmp_path):
+    argv = ["--data", str(tiny_benchmark), "--methods", "2D-S,2D-SS", "--views", "ideal",
+            "--results", str(tmp_path / "results"), "--out", str(tmp_path / "out")]
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(argv) == 0
+    out = tmp_path / "out"
+    rows = read_building_errors_csv(out / "per_building.csv")
+    assert len(rows) == 6 and {r.status for r in rows} == {"ok"}
+    # A sanity bound, not an accuracy claim: 96 px renders, every family.
+    assert all(0 <= r.wwr_ape < 50 for r in rows), [(r.scene, r.method, r.wwr_ape) for r in rows]
+    assert {r.family for r in rows} == {"skyscraper", "l_shaped", "realistic"}
+    kinds = sorted(p.name.rsplit("__", 1)[1] for p in (out / "2dss_pipeline").iterdir())
+    assert kinds == ["corners.png", "mask.png", "rectified.png"]
+    prov = json.loads((out / "provenance.json").read_text())
+    assert {r["status"] for r in prov["runs"]} == {"ran"}
+    assert prov["methods"]["2D-SS"]["config"]  # the config the method ran with
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main(argv) == 0
+    prov = json.loads((out / "provenance.json").read_text())
+    assert {r["status"] for r in prov["runs"]} == {"reused"}

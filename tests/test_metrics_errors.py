@@ -125,4 +125,14 @@ def test_facade_errors_missing_unknown_and_unmatched_protocol():
         (1, "failed", "no usable view"), (2, "ok", ""), (3, "failed", "no such facade in the truth")
     ]
     assert facade_errors(replace(result, protocol="train"), make_truth("a")) == ()
+
+
+def test_neural3d_facades_count_only_when_matched_to_the_truth():
+    result = make_result("a", "neural3d", "train", 0.25, facade_wwrs=(0.3, 0.25))
+    matched = replace(result, config={"match_truth_facades": True})
+    assert [r.wwr_ape for r in facade_errors(matched, make_truth("a"))] == pytest.approx(
+        [20.0, 0.0], abs=TOL)
+    unmatched = replace(matched, warnings=(
+        "facade ids are the mesh's own group numbers (no truth mesh matched)",))
+    assert facade_errors(unmatched, make_truth("a")) == ()
     assert facade_errors(result, None) == ()
