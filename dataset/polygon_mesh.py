@@ -56,7 +56,7 @@ class PlanarFace:
             raise ValueError("a planar face needs rings of shape (n >= 3, 3)")
         normal = np.asarray(self.normal, dtype=np.float64)
         length = float(np.linalg.norm(normal))
-        if normal.shape != (3,) or not np.isclose(length, 1.0, atol=1e-9):
+        if normal.shape != (3,) or abs(length - 1.0) > 1e-9:
             raise ValueError(f"face normal must be a (3,) unit vector, got {self.normal}")
         if not 0 <= int(self.label) < NUM_CLASSES:
             raise ValueError(f"unknown class id {self.label}")
@@ -70,9 +70,9 @@ def plane_basis(normal: np.ndarray) -> np.ndarray:
     """(2, 3) orthonormal in-plane axes (u, v) with u x v = ``normal`` (unit, (3,))."""
     n = np.asarray(normal, dtype=np.float64)
     helper = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    u = np.cross(helper, n)
+    u = _cross_3d(helper, n)
     u /= np.linalg.norm(u)
-    return np.stack([u, np.cross(n, u)])
+    return np.stack([u, _cross_3d(n, u)])
 
 
 def face_polygon_2d(face: PlanarFace) -> Polygon:
@@ -88,14 +88,26 @@ def _triangulate_face(face: PlanarFace) -> tuple[np.ndarray, np.ndarray]:
     points_2d = points @ plane_basis(face.normal).T
     ends = np.cumsum([len(r) for r in face.rings_m]).astype(np.uint32)
     tri = np.asarray(mapbox_earcut.triangulate_float64(points_2d, ends), dtype=np.int64)
-    tri = _repair_t_junctions(points_2d, tri.reshape(-1, 3))
+    tri = tri.reshape(-1, 3)
+    if len(face.rings_m) > 1 or len(points) > 4:  # a lone triangle or quad has no T-junction
+        tri = _repair_t_junctions(points_2d, tri)
     if len(tri) == 0:
         raise ValueError(f"face with {len(points)} vertices has no area to triangulate")
     t = points[tri]
-    facing = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]) @ face.normal
+    facing = _cross_3d(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]) @ face.normal
     flip = facing < 0
     tri[flip] = tri[flip][:, ::-1]
     return tri, points
+
+
+def _cross_3d(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of (..., 3) vectors (np.cross is slow on the many tiny faces here)."""
+    return np.stack(
+        [a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+         a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+         a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]],
+        axis=-1,
+    )
 
 
 def _cross_2d(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -36,7 +36,14 @@ _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 # footprints); tests/test_presets.py checks that they stay small.
 _TINY_SKYSCRAPER_SEED = 38
 _TINY_L_SHAPED_SEED = 37
-_PAPER_SEED_BASE = {"skyscraper": 1000, "l_shaped": 2000, "realistic": 3000}
+# Seeds of the paper preset: from seeds 1000-1199 (2000-2199), those whose samples reach the
+# lowest and highest floors, footprint, height and WWR, filled up with the first others, so
+# that 12 buildings span each family's ranges (docs/buildings.md lists the ranges reached).
+_PAPER_SEEDS = {
+    "skyscraper": (1000, 1001, 1002, 1003, 1012, 1023, 1044, 1098, 1122, 1130, 1174, 1191),
+    "l_shaped": (2000, 2001, 2002, 2003, 2004, 2005, 2006, 2040, 2046, 2060, 2122, 2143),
+}
+_REALISTIC_SEED = 3000
 
 
 @dataclass(frozen=True)
@@ -73,16 +80,16 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
         return (
             BuildingRecipe("tiny_skyscraper", "skyscraper", _TINY_SKYSCRAPER_SEED),
             BuildingRecipe("tiny_l_shaped", "l_shaped", _TINY_L_SHAPED_SEED),
-            BuildingRecipe("realistic_house", "realistic", _PAPER_SEED_BASE["realistic"], "house"),
+            BuildingRecipe("realistic_house", "realistic", _REALISTIC_SEED, "house"),
         )
     if name == "paper":
         recipes = [
-            BuildingRecipe(f"{family}_{i:02d}", family, _PAPER_SEED_BASE[family] + i)
+            BuildingRecipe(f"{family}_{i:02d}", family, seed)
             for family in ("skyscraper", "l_shaped")
-            for i in range(12)
+            for i, seed in enumerate(_PAPER_SEEDS[family])
         ]
         recipes += [
-            BuildingRecipe(f"realistic_{m}", "realistic", _PAPER_SEED_BASE["realistic"] + k, m)
+            BuildingRecipe(f"realistic_{m}", "realistic", _REALISTIC_SEED + k, m)
             for k, m in enumerate(REALISTIC_MODELS)
         ]
         return tuple(recipes)

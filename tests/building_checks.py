@@ -93,9 +93,12 @@ def check_closed_bodies(building: Building) -> int:
 
 
 def check_no_coplanar_overlap(building: Building) -> None:
-    """Faces that lie in one plane never overlap: their summed area equals their union's."""
+    """Faces that lie in one plane (either side) never overlap: summed area equals union area."""
     mesh = building.mesh
     normals, tris = mesh.face_normals(), mesh.triangles_m
+    # One key per unoriented plane, so that back-to-back faces are compared too.
+    first = np.argmax(np.abs(normals) > 1e-9, axis=1)
+    normals = normals * np.sign(normals[np.arange(len(normals)), first])[:, None]
     offsets = np.einsum("ij,ij->i", normals, tris[:, 0])
     groups: dict[tuple, list[int]] = defaultdict(list)
     keys = np.round(np.column_stack([normals, offsets]), 6) + 0.0
