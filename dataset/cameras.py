@@ -88,7 +88,10 @@ class FacadeViewConfig:
     off the normal. ``eye_height_m``: lowest camera height. ``multi_distance_factor``:
     distance drawn as a multiple of the ideal view's. ``min_visible_fraction``:
     least share of the facade's surface (sampled at ``visibility_samples`` points)
-    seen unoccluded. ``max_attempts``: draws per multi view before it is dropped.
+    seen unoccluded by a multi view; ``ideal_min_visible_fraction`` the same for an
+    ideal view, which has no other position to try and so accepts more occlusion
+    (balconies in front of the facade). ``max_attempts``: draws per multi view
+    before it is dropped.
     """
 
     margin: float = 0.08
@@ -98,6 +101,7 @@ class FacadeViewConfig:
     eye_height_m: float = 1.6
     multi_distance_factor: tuple[float, float] = (1.0, 1.5)
     min_visible_fraction: float = 0.6
+    ideal_min_visible_fraction: float = 0.3
     visibility_samples: int = 200
     max_attempts: int = 30
 
@@ -108,8 +112,12 @@ class FacadeViewConfig:
             raise ValueError("multi_count must be >= 1 and multi_azimuth_deg in [0, 90)")
         if not 0 < self.multi_distance_factor[0] <= self.multi_distance_factor[1]:
             raise ValueError("multi_distance_factor must satisfy 0 < lo <= hi")
-        if not 0 <= self.min_visible_fraction <= 1 or self.visibility_samples < 1:
-            raise ValueError("min_visible_fraction in [0, 1] and visibility_samples >= 1")
+        fractions = (self.min_visible_fraction, self.ideal_min_visible_fraction)
+        if not all(0 <= f <= 1 for f in fractions) or self.visibility_samples < 1:
+            raise ValueError(
+                "min_visible_fraction and ideal_min_visible_fraction must be in [0, 1], "
+                "visibility_samples >= 1"
+            )
 
 
 def point_of_interest_m(raycaster: Raycaster) -> np.ndarray:
@@ -213,14 +221,15 @@ def ideal_views(
     The optical axis is the facade's inward normal through the centre of its
     rectangle; the distance fits the whole rectangle with ``config.margin``. A
     facade whose ideal camera would sit inside the building or see less than
-    ``min_visible_fraction`` of it gets no view (with a warning).
+    ``ideal_min_visible_fraction`` of it gets no view (with a warning).
     """
     views = []
     for patch in facade_patches(building, sector_deg=config.sector_deg):
         distance = _fit_distance_m(patch, intrinsics, config.margin)
         eye = patch.centre_m + distance * patch.normal
         pose = look_at(eye, patch.centre_m)
-        problem = _facade_view_problem(raycaster, patch, pose, config)
+        problem = _facade_view_problem(raycaster, patch, pose, config,
+                                       config.ideal_min_visible_fraction)
         if problem:
             warnings.warn(
                 f"building {building.truth.id}: facade {patch.facade_id} gets no ideal view "
@@ -288,13 +297,15 @@ def _multi_pose(
         eye[2] = eye_z
         pose = look_at(eye, patch.centre_m)
         if _corners_in_image(patch, intrinsics, pose, margin=0.02):
-            return pose, _facade_view_problem(raycaster, patch, pose, config)
+            return pose, _facade_view_problem(raycaster, patch, pose, config,
+                                              config.min_visible_fraction)
         distance *= 1.15
     return pose, "facade does not fit in the image"
 
 
 def _facade_view_problem(
-    raycaster: Raycaster, patch: FacadePatch, pose: np.ndarray, config: FacadeViewConfig
+    raycaster: Raycaster, patch: FacadePatch, pose: np.ndarray, config: FacadeViewConfig,
+    min_visible: float,
 ) -> str:
     eye = pose[:3, 3]
     if raycaster.contains(eye[None])[0]:
@@ -305,7 +316,7 @@ def _facade_view_problem(
     # A sample is seen when nothing stops the ray before it (1 cm slack).
     slack = 0.01 / np.linalg.norm(to_points, axis=1)
     visible = float(np.mean(t >= 1 - slack))
-    if visible < config.min_visible_fraction:
+    if visible < min_visible:
         return f"only {visible:.0%} of the facade visible"
     return ""
 

@@ -27,6 +27,7 @@ from dataset.classes import NO_FACADE, SemanticClass
 from dataset.footprint import polygon_to_geojson
 from dataset.generate import GenerateConfig, generate_preset
 from dataset.mesh import LabelledMesh, concatenate_meshes
+from dataset.scene import read_scene
 from dataset.truth import Building, BuildingTruth, FacadeTruth
 from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
 
@@ -123,6 +124,22 @@ def make_box_building() -> Building:
 def box_building() -> Building:
     """A labelled box building with exact truth (see the module docstring)."""
     return make_box_building()
+
+
+def assert_complete_scene(root: Path, config: GenerateConfig) -> None:
+    """A finished scene: every frame's files exist, splits and intrinsics as configured."""
+    scene = read_scene(root)
+    assert scene.building is not None
+    for frame in scene.frames:
+        for rel in (frame.file_path, frame.depth_file_path, frame.semantic_file_path,
+                    frame.normal_file_path, frame.instance_file_path):
+            assert rel is not None and scene.path(rel).is_file(), rel
+        assert (frame.facade_id is not None) == (frame.split in ("ideal", "multi"))
+        assert frame.intrinsics == config.intrinsics()
+    n_train = len(scene.frames_in("train"))
+    assert n_train + len(scene.frames_in("eval")) == config.views
+    assert n_train == int(np.floor(config.views * config.train_fraction))
+    assert not list(root.parent.glob(".*.partial"))
 
 
 TINY_CONFIG = GenerateConfig(resolution=96, views=16)
