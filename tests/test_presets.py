@@ -43,8 +43,13 @@ def tiny_buildings() -> list[Building]:
 
 
 @pytest.fixture(scope="module")
-def paper_truths():
-    return [build_building(r).truth for r in preset_recipes("paper")]
+def paper_buildings() -> list[Building]:
+    return [build_building(r) for r in preset_recipes("paper")]
+
+
+@pytest.fixture(scope="module")
+def paper_truths(paper_buildings):
+    return [b.truth for b in paper_buildings]
 
 
 def test_tiny_preset_is_one_small_building_per_family(tiny_buildings):
@@ -97,6 +102,11 @@ def test_paper_preset_has_28_buildings_in_the_family_ranges(paper_truths):
         assert area[0] <= truth.footprint_area_m2 <= area[1], truth.id
         assert height[0] <= truth.height_m <= height[1], truth.id
         assert wwr[0] <= truth.wwr <= wwr[1], truth.id
+
+
+def test_paper_buildings_agree_with_their_meshes(paper_buildings):
+    for building in paper_buildings:
+        check_building(building)
 
 
 def test_paper_preset_spans_its_ranges(paper_truths):
