@@ -55,14 +55,17 @@ class ExtractConfig:
 
     ``resolution`` is the number of marching-cubes samples along the scene box's
     longest side. The footprint plane sits ``footprint_height_m`` above the
-    ground (z = 0): above the ground's reconstruction noise, below sills and overhangs.
+    ground (z = 0): above the ground's reconstruction noise, below sills and
+    overhangs; its grid spacing ``footprint_cell_m`` is, when None, half the
+    mesh's voxel, so the footprint is as fine as the mesh and costs
+    (2 x resolution)² field queries.
     """
 
     resolution: int = 256
     chunk_points: int = 1 << 16
     min_component_area_fraction: float = 0.01  # floaters of a neural SDF
     footprint_height_m: float = 0.5
-    footprint_cell_m: float = 0.05
+    footprint_cell_m: float | None = None
     footprint_min_area_m2: float = 1.0
     match_truth_facades: bool = True
     measure: MeasureConfig = field(default_factory=MeasureConfig)
@@ -107,6 +110,14 @@ def field_color_fn(trained, device: torch.device, chunk_points: int) -> ColorFn:
                         grad=True)
 
     return color
+
+
+def footprint_cell_m(box_min_m: np.ndarray, box_max_m: np.ndarray, config: ExtractConfig) -> float:
+    """Footprint grid spacing in m: ``config.footprint_cell_m``, or half the mesh voxel if None."""
+    if config.footprint_cell_m is not None:
+        return config.footprint_cell_m
+    longest_m = float(np.max(np.asarray(box_max_m) - np.asarray(box_min_m)))
+    return 0.5 * longest_m / (config.resolution - 1)
 
 
 def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device) -> SemanticMesh:
@@ -159,7 +170,8 @@ def measure_field(
         polygon = footprint_from_sdf(
             field_sdf_fn(trained, device, config.chunk_points), trained.box_min_m,
             trained.box_max_m, height_m=config.footprint_height_m,
-            cell_m=config.footprint_cell_m, min_area_m2=config.footprint_min_area_m2,
+            cell_m=footprint_cell_m(trained.box_min_m, trained.box_max_m, config),
+            min_area_m2=config.footprint_min_area_m2,
             chunk_points=config.chunk_points,
         )
         footprint = polygon_to_geojson(polygon)

@@ -111,3 +111,27 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
 def test_bad_config():
     with pytest.raises(ValueError, match="resolution"):
         ExtractConfig(resolution=4)
+
+
+def test_extract_run_on_a_trained_run(box_building, tmp_path):
+    """A few iterations of the tiny preset: the plumbing from checkpoint to files, not accuracy."""
+    from dataclasses import replace
+
+    from neural3d_scene import write_ring_scene
+
+    from neural3d.config import preset_config
+    from neural3d.train import train
+
+    scene = write_ring_scene(box_building, tmp_path / "box", size_px=24, n_train=8, n_eval=0)
+    write_labelled_ply(scene / "mesh.ply", box_building.mesh)
+    config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
+    run_dir = train(scene, config, tmp_path / "runs", device=torch.device("cpu"))
+    out = tmp_path / "out"
+    assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out)]) == 0
+    result = read_result(out / result_filename("box", "neural3d", "train"))
+    assert (result.method, result.protocol) == ("neural3d", "train")
+    assert [f.id for f in result.facades] == [1, 2, 3, 4]  # matched, or missing with a reason
+    assert all(f.reason for f in result.facades if f.missing)
+    v, f, labels, rgb = read_semantic_ply(out / "mesh.ply")
+    assert len(f) > 0 and labels.max() < len(CLASS_NAMES)
+    assert (out / "footprint.geojson").is_file() == (result.footprint is not None)
