@@ -37,6 +37,23 @@ def enclosing_quadrilateral(mask: np.ndarray) -> np.ndarray:
     ViewError
         If the mask is empty or too small to have four corners.
     """
+    contour = outer_contour_uv(mask)
+    hull = cv2.convexHull(contour.astype(np.float32)).reshape(-1, 2).astype(np.float64)
+    if len(hull) < 4 or _polygon_area(hull) < 4.0:
+        raise ViewError("the facade mask is too small to have four corners")
+    quad = minimum_area_quadrilateral(hull)
+    quad = _refine_sides(quad, contour)
+    return order_corners(quad)
+
+
+def outer_contour_uv(mask: np.ndarray) -> np.ndarray:
+    """(N, 2) float64 centres (u, v) of the boundary pixels of the mask's largest outer contour.
+
+    Raises
+    ------
+    ViewError
+        If the mask is empty.
+    """
     mask = np.asarray(mask)
     if mask.ndim != 2:
         raise ValueError(f"mask must be (H, W), got shape {mask.shape}")
@@ -45,13 +62,7 @@ def enclosing_quadrilateral(mask: np.ndarray) -> np.ndarray:
     )
     if not contours:
         raise ViewError("the facade mask is empty")
-    contour = max(contours, key=len).reshape(-1, 2).astype(np.float64) + 0.5
-    hull = cv2.convexHull(contour.astype(np.float32)).reshape(-1, 2).astype(np.float64)
-    if len(hull) < 4 or _polygon_area(hull) < 4.0:
-        raise ViewError("the facade mask is too small to have four corners")
-    quad = minimum_area_quadrilateral(hull)
-    quad = _refine_sides(quad, contour)
-    return order_corners(quad)
+    return max(contours, key=len).reshape(-1, 2).astype(np.float64) + 0.5
 
 
 def minimum_area_quadrilateral(hull: np.ndarray) -> np.ndarray:

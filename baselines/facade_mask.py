@@ -10,7 +10,8 @@ neighbouring facade too, joined to the target along the building corner.
 * 2D-SS also has depth: it fits the dominant plane through the facade pixels
   near the image centre (RANSAC on back-projected points) and keeps the wall
   pixels on that plane and the window/door pixels on it or recessed behind it,
-  then the component at the centre.
+  then the component at the centre. The plane is anchored at the wall pixels
+  nearest the image centre, so a bigger neighbouring facade does not win.
 """
 
 from __future__ import annotations
@@ -37,7 +38,8 @@ class PlaneIsolationConfig:
     pixel may lie up to this far behind the plane (reveals and recessed glass).
     ``centre_fraction``: RANSAC samples facade pixels in the central box of this
     fraction of the image width and height. ``sample_points``: at most this many
-    points are sampled for RANSAC.
+    points are sampled for RANSAC. ``anchor_points``: every RANSAC plane passes
+    through one of this many wall pixels nearest the image centre.
     """
 
     wall_tolerance_m: float = 0.05
@@ -46,14 +48,16 @@ class PlaneIsolationConfig:
     centre_fraction: float = 0.5
     sample_points: int = 1500
     min_centre_points: int = 50
+    anchor_points: int = 32
 
     def __post_init__(self) -> None:
         if self.wall_tolerance_m <= 0 or self.recess_max_m < 0:
             raise ValueError("wall_tolerance_m must be > 0 and recess_max_m >= 0")
         if not 0 < self.centre_fraction <= 1:
             raise ValueError(f"centre_fraction must be in (0, 1], got {self.centre_fraction}")
-        if self.ransac_iterations < 1 or self.sample_points < 3:
-            raise ValueError("ransac_iterations must be >= 1 and sample_points >= 3")
+        if self.ransac_iterations < 1 or self.sample_points < 3 or self.anchor_points < 1:
+            raise ValueError("ransac_iterations, sample_points (>= 3) and anchor_points "
+                             "must be positive")
 
 
 def facade_class_mask(labels: np.ndarray) -> np.ndarray:
@@ -138,10 +142,17 @@ def isolate_facade_on_plane(
         central = np.arange(len(ys))
     sample = central[_subsample(len(central), config.sample_points, rng)]
     refine = _subsample(len(ys), 4 * config.sample_points, rng)
+    # Anchor the plane at the wall pixels nearest the image centre (where the
+    # photographer aimed): the biggest plane in view may be a neighbour.
+    walls = np.nonzero(labels[ys, xs] == SemanticClass.WALL)[0]
+    walls = walls if len(walls) else np.arange(len(ys))
+    r2 = (xs[walls] + 0.5 - w / 2) ** 2 + (ys[walls] + 0.5 - h / 2) ** 2
+    anchors = walls[np.argsort(r2)[: config.anchor_points]]
     try:
         plane = fit_plane_ransac(
             pts[sample], threshold_m=config.wall_tolerance_m,
             iterations=config.ransac_iterations, rng=rng, refine_points_m=pts[refine],
+            anchor_points_m=pts[anchors],
         )
     except ValueError as exc:
         raise ViewError(f"no facade plane in the depth image: {exc}") from exc

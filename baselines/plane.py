@@ -61,12 +61,15 @@ def fit_plane_ransac(
     iterations: int,
     rng: np.random.Generator,
     refine_points_m: np.ndarray | None = None,
+    anchor_points_m: np.ndarray | None = None,
 ) -> Plane:
     """The plane with most inliers among ``points_m`` (N, 3), refined by least squares.
 
     Candidate planes come from random triples of ``points_m`` and are scored on
     them; the best is then refitted twice by least squares to its inliers among
-    ``refine_points_m`` (M, 3) (default ``points_m``).
+    ``refine_points_m`` (M, 3) (default ``points_m``). With ``anchor_points_m``
+    (A, 3), every candidate passes through one of them: the plane sought is the
+    best-supported one through the anchors, not the best-supported overall.
 
     Raises
     ------
@@ -80,6 +83,11 @@ def fit_plane_ransac(
         raise ValueError("threshold_m must be > 0 and iterations >= 1")
     idx = rng.integers(0, len(p), (iterations, 3))  # repeated indices give a zero normal
     a, b, c = p[idx[:, 0]], p[idx[:, 1]], p[idx[:, 2]]
+    if anchor_points_m is not None:
+        anchors = np.asarray(anchor_points_m, dtype=np.float64).reshape(-1, 3)
+        if len(anchors) == 0:
+            raise ValueError("anchor_points_m is empty")
+        a = anchors[rng.integers(0, len(anchors), iterations)]
     normals = np.cross(b - a, c - a)
     norms = np.linalg.norm(normals, axis=1)
     ok = norms > 1e-12

@@ -7,7 +7,10 @@ Per view (see each module for the details):
 2. the four corners of the quadrilateral that best encloses it
    (:func:`baselines.corners.enclosing_quadrilateral`);
 3. the corners' rays meet the facade plane: facade length L, height H, alpha = L / H
-   (:mod:`baselines.backproject`);
+   (:mod:`baselines.backproject`). If that 3D quadrilateral is not a rectangle
+   (a corner angle off 90 degrees by more than ``max_corner_angle_error_deg``:
+   a gable, an occluded corner), the facade's upright bounding rectangle in its
+   plane replaces it;
 4. a homography maps the quadrilateral onto a fronto-parallel rectangle of
    aspect alpha; all views of a run are warped with kornia in batches and the
    WWR is window / facade pixels inside the rectangle (:mod:`baselines.rectify`).
@@ -31,9 +34,15 @@ import numpy as np
 import torch
 
 from baselines.aggregate import COMBINES, Combine, building_result, combine_values, missing_facade
-from baselines.backproject import corners_camera_m, facade_size_m
+from baselines.backproject import (
+    corner_angles_deg,
+    corners_camera_m,
+    facade_size_m,
+    image_from_camera_uv,
+    upright_rectangle_m,
+)
 from baselines.cli import add_common_arguments, main_guarded, run_scenes
-from baselines.corners import corners_inside_image, enclosing_quadrilateral
+from baselines.corners import corners_inside_image, enclosing_quadrilateral, outer_contour_uv
 from baselines.debug import colour_labels, draw_corners, write_debug_image
 from baselines.facade_mask import PlaneIsolationConfig, isolate_facade_on_plane
 from baselines.rectify import OUTSIDE, rectangle_size_px, rectified_wwr, rectify_labels
@@ -54,7 +63,9 @@ class Wwr2dssConfig:
     the square canvas the facades are rectified onto. ``batch_size``: views
     warped per kornia call. ``corner_margin_px``: a corner closer than this to
     the image border (or outside) means the facade is cut off; the view is
-    skipped. ``seed``: RANSAC randomness.
+    skipped. ``max_corner_angle_error_deg``: largest deviation from 90 degrees
+    of a corner of the back-projected quadrilateral before the upright bounding
+    rectangle replaces it. ``seed``: RANSAC randomness.
     """
 
     weighting: Literal["alpha", "area"] = "alpha"
@@ -63,6 +74,7 @@ class Wwr2dssConfig:
     canvas_px: int = 512
     batch_size: int = 32
     corner_margin_px: float = 1.0
+    max_corner_angle_error_deg: float = 5.0
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -72,6 +84,8 @@ class Wwr2dssConfig:
             raise ValueError(f"combine must be one of {COMBINES}, got {self.combine!r}")
         if self.canvas_px < 8 or self.batch_size < 1:
             raise ValueError("canvas_px must be >= 8 and batch_size >= 1")
+        if not 0 < self.max_corner_angle_error_deg <= 90:
+            raise ValueError("max_corner_angle_error_deg must be in (0, 90]")
 
 
 @dataclass(frozen=True)
@@ -79,7 +93,9 @@ class ViewGeometry:
     """The geometric half of 2D-SS on one view (before rectification).
 
     ``mask`` (H, W) bool; ``corners_uv`` (4, 2) image corners TL, TR, BR, BL;
-    ``corners_m`` (4, 3) the same in the camera frame (m).
+    ``corners_m`` (4, 3) the same in the camera frame (m); ``corners_from``
+    says whether they come from the enclosing quadrilateral or the upright
+    bounding rectangle.
     """
 
     view: FacadeView
@@ -88,6 +104,7 @@ class ViewGeometry:
     corners_m: np.ndarray
     length_m: float
     height_m: float
+    corners_from: Literal["quadrilateral", "upright_rectangle"] = "quadrilateral"
 
 
 def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
@@ -105,10 +122,16 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
     k = view.intrinsics
     mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, config.isolation, rng)
     corners = enclosing_quadrilateral(mask)
-    corners_inside_image(corners, k.width, k.height, config.corner_margin_px)
     corners_m = corners_camera_m(corners, plane, k)
+    source = "quadrilateral"
+    if np.max(np.abs(corner_angles_deg(corners_m) - 90.0)) > config.max_corner_angle_error_deg:
+        up_camera = view.frame.world_from_camera[:3, :3].T @ np.array([0.0, 0.0, 1.0])
+        corners_m = upright_rectangle_m(outer_contour_uv(mask), plane, k, up_camera)
+        corners = image_from_camera_uv(corners_m, k)
+        source = "upright_rectangle"
+    corners_inside_image(corners, k.width, k.height, config.corner_margin_px)
     length, height = facade_size_m(corners_m)
-    return ViewGeometry(view, mask, corners, corners_m, length, height)
+    return ViewGeometry(view, mask, corners, corners_m, length, height, source)
 
 
 def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
