@@ -218,3 +218,39 @@ def vertical_quad(
          [q_xy[0], q_xy[1], z1_m], [p_xy[0], p_xy[1], z1_m]]
     )
     return PlanarFace((ring,), normal, label, facade_id)
+
+
+def swept_faces(
+    ring_m: np.ndarray, offset_m: np.ndarray, *, label: int, facade_id: int = NO_FACADE
+) -> list[PlanarFace]:
+    """Closed prism swept by a planar simple polygon along a vector perpendicular to it.
+
+    Parameters
+    ----------
+    ring_m : (n, 3) float
+        Corners of a simple planar polygon (either orientation), world metres.
+    offset_m : (3,) float
+        Sweep vector, perpendicular to the polygon's plane; its length is the prism's length.
+
+    Returns the two caps and one quad per edge, all with outward normals.
+    """
+    ring = np.asarray(ring_m, dtype=np.float64)
+    offset = np.asarray(offset_m, dtype=np.float64)
+    length = float(np.linalg.norm(offset))
+    if ring.ndim != 2 or ring.shape[1] != 3 or len(ring) < 3 or length <= 0:
+        raise ValueError("a sweep needs an (n >= 3, 3) ring and a non-zero (3,) offset")
+    d = offset / length
+    newell = _cross_3d(ring, np.roll(ring, -1, axis=0)).sum(axis=0)
+    if abs(newell @ d) < (1 - 1e-9) * np.linalg.norm(newell):
+        raise ValueError("the sweep offset must be perpendicular to the ring's plane")
+    # Seen from +d, a counter-clockwise ring has its outside to the right of each edge.
+    side = 1.0 if newell @ d > 0 else -1.0
+    faces = [
+        PlanarFace((ring,), -d, label, facade_id),
+        PlanarFace((ring + offset,), d, label, facade_id),
+    ]
+    for p, q in zip(ring, np.roll(ring, -1, axis=0)):
+        n = side * _cross_3d(q - p, d)
+        quad = np.stack([p, q, q + offset, p + offset])
+        faces.append(PlanarFace((quad,), n / np.linalg.norm(n), label, facade_id))
+    return faces

@@ -20,7 +20,7 @@ from shapely.geometry import Polygon
 
 from dataset.classes import SemanticClass
 from dataset.facade_geometry import Opening, WallFrame, WallSpec, rectangle_outline
-from dataset.polygon_mesh import PlanarFace, vertical_quad
+from dataset.polygon_mesh import PlanarFace, swept_faces, vertical_quad
 
 UP = np.array([0.0, 0.0, 1.0])
 DOWN = np.array([0.0, 0.0, -1.0])
@@ -197,3 +197,35 @@ def gable_roof_faces(walls: list[WallSpec]) -> list[PlanarFace]:
 def _gable_apex(wall: WallSpec, ridge_height_m: float) -> np.ndarray:
     """(1, 3) apex of a gable wall, computed as the wall computes it (exact vertex sharing)."""
     return wall.frame.points_m(np.array([[wall.frame.length_m / 2, ridge_height_m]]))
+
+
+def gable_roof_shell_faces(
+    walls: list[WallSpec], overhang_m: float, thickness_m: float, gap_m: float
+) -> tuple[list[PlanarFace], float]:
+    """A roof slab over :func:`gable_walls` that overhangs eaves and gables, as its own body.
+
+    The slab floats ``gap_m`` (measured perpendicular to the slopes) above the roof
+    planes, so it shares no face or vertex with the house, and sticks out
+    ``overhang_m`` (horizontally) beyond every wall. Class roof.
+
+    Returns the faces and the height of the slab's top at the ridge, metres.
+    """
+    if min(overhang_m, thickness_m, gap_m) <= 0:
+        raise ValueError("roof shell overhang, thickness and gap must be > 0 m")
+    eave = float(walls[0].outline_uv[2, 1])
+    ridge = float(walls[1].outline_uv[3, 1])
+    along, length = walls[0].frame.u_axis, walls[0].frame.length_m
+    across, depth = -walls[0].frame.normal, walls[1].frame.length_m
+    half = depth / 2
+    cos = half / np.hypot(half, ridge - eave)
+    lift, thick = gap_m / cos, thickness_m / cos
+
+    def under_z(s: float) -> float:
+        return eave + lift + (ridge - eave) * (1 - abs(s - half) / half)
+
+    section = [(s, under_z(s)) for s in (-overhang_m, half, depth + overhang_m)]
+    section += [(s, z + thick) for s, z in reversed(section)]
+    origin = np.array([*walls[0].frame.p0_xy, 0.0]) - overhang_m * along
+    ring = np.array([origin + s * across + [0.0, 0.0, z] for s, z in section])
+    faces = swept_faces(ring, (length + 2 * overhang_m) * along, label=SemanticClass.ROOF)
+    return faces, under_z(half) + thick

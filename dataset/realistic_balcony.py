@@ -113,7 +113,7 @@ def balcony_layout(params: RealisticParams, *, continuous: bool) -> BuildingLayo
                                        centre + ww / 2, z + BALCONY_DOOR_SILL_M
                                        + BALCONY_DOOR_HEIGHT_M, reveal))
                     if not continuous:
-                        half = min(bay - 0.3, 2.8) / 2
+                        half = min(bay - 1.0, 2.4) / 2  # visibly separate balconies
                         cts.append((centre - half, z - SLAB_THICKNESS_M, centre + half, z))
                 elif not (i == 0 and k == 0 and c == cols // 2):  # the door's bay
                     ops.append(Opening("window", centre - ww / 2, z + sill, centre + ww / 2,

@@ -2,11 +2,12 @@
 
 Rectangular footprint ``width_m`` (x, along the ridge) by ``depth_m`` (y),
 ``floors`` storeys below the eaves and a gable roof rising ``roof_m`` to the
-ridge. Facades: 1 south (front door, large ground-floor windows), 2 east gable,
-3 north (back door, small ground-floor windows), 4 west gable; each gable has
-a small attic window in its triangle. A chimney (class other, its own closed
-body) rises through the north slope; it starts inside the house, so it needs no
-hole in the roof.
+ridge, covered by a roof slab that overhangs eaves and gables (its own closed
+body, floating 1 cm above the roof planes). Facades: 1 south (front door, large
+ground-floor windows), 2 east gable, 3 north (back door, small ground-floor
+windows), 4 west gable; each gable has a small attic window in its triangle. A
+chimney (class other, its own closed body) rises through the north slope; it
+starts inside the house, so it needs no hole in the roof.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from dataset.building_assembly import BuildingLayout
 from dataset.classes import SemanticClass
 from dataset.facade_geometry import Opening, drop_near, window_grid
 from dataset.polygon_mesh import extruded_faces
-from dataset.prism import gable_roof_faces, gable_walls, ground_face
+from dataset.prism import gable_roof_faces, gable_roof_shell_faces, gable_walls, ground_face
 
 if TYPE_CHECKING:
     from dataset.realistic import RealisticParams
@@ -30,6 +31,9 @@ DOOR_HEIGHT_M = 2.2
 DOOR_THRESHOLD_M = 0.15
 CHIMNEY_SIZE_M = 0.6
 CHIMNEY_ABOVE_RIDGE_M = 0.6
+EAVES_OVERHANG_M = 0.4
+ROOF_SHELL_THICKNESS_M = 0.2
+ROOF_SHELL_GAP_M = 0.01
 
 
 def _door(centre_u: float, depth_m: float) -> Opening:
@@ -67,6 +71,8 @@ def house_layout(params: RealisticParams) -> BuildingLayout:
                         reveal)
         gables.append([*grid(d, 2, ww, wh, sill, 0, n), attic])
     walls = gable_walls(footprint, eave, ridge, [1, 2, 3, 4], [south, gables[0], north, gables[1]])
+    shell, top = gable_roof_shell_faces(walls, EAVES_OVERHANG_M, ROOF_SHELL_THICKNESS_M,
+                                        ROOF_SHELL_GAP_M)
     cx, cy, half = w / 4, d / 4, CHIMNEY_SIZE_M / 2
     chimney = extruded_faces(
         box(cx - half, cy - half, cx + half, cy + half), eave - 0.5,
@@ -75,11 +81,12 @@ def house_layout(params: RealisticParams) -> BuildingLayout:
     return BuildingLayout(
         footprint_xy=footprint,
         walls=walls,
-        other_faces=[ground_face(footprint), *gable_roof_faces(walls), *chimney],
+        other_faces=[ground_face(footprint), *gable_roof_faces(walls), *shell, *chimney],
         floors=n,
-        height_m=ridge,
+        height_m=top,
         extra={
-            "roof": {"kind": "gable", "eave_height_m": eave, "ridge_height_m": ridge},
+            "roof": {"kind": "gable", "eave_height_m": eave, "ridge_height_m": ridge,
+                     "overhang_m": EAVES_OVERHANG_M, "roof_top_m": top},
             "chimney_top_m": ridge + CHIMNEY_ABOVE_RIDGE_M,
         },
     )

@@ -11,6 +11,7 @@ from dataset.polygon_mesh import (
     extruded_faces,
     face_polygon_2d,
     plane_basis,
+    swept_faces,
     triangulate_faces,
     vertical_quad,
 )
@@ -74,6 +75,18 @@ def test_extrusion_is_closed_with_exact_volume(polygon):
     assert mesh.face_areas_m2().sum() == pytest.approx(
         2 * polygon.area + polygon.length * 2.5, rel=1e-12
     )
+
+
+@pytest.mark.parametrize("reverse", [False, True])
+def test_sweep_is_closed_with_exact_volume_either_ring_orientation(reverse):
+    ring = np.array([[0, -5, 6], [0, 0, 9], [0, 5, 6], [0, 5, 6.2], [0, 0, 9.2], [0, -5, 6.2]])
+    ring = ring[::-1] if reverse else ring
+    mesh = triangulate_faces(swept_faces(ring.astype(float), np.array([10.0, 0, 0]), label=3))
+    tm = trimesh.Trimesh(mesh.vertices_m, mesh.faces, process=False)
+    assert tm.is_watertight and tm.is_winding_consistent
+    assert tm.volume == pytest.approx(2 * 5 * 0.2 * 10, rel=1e-12)
+    with pytest.raises(ValueError, match="perpendicular"):
+        swept_faces(ring.astype(float), np.array([1.0, 1.0, 0]), label=3)
 
 
 def test_vertical_quad_faces_right_of_its_edge():

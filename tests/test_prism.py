@@ -10,6 +10,7 @@ from dataset.polygon_mesh import triangulate_faces
 from dataset.prism import (
     edge_frames,
     gable_roof_faces,
+    gable_roof_shell_faces,
     gable_walls,
     ground_face,
     offset_ring,
@@ -64,6 +65,24 @@ def test_gable_roof_volume_and_gable_walls():
     assert walls[1].gross_area_m2() == pytest.approx(6.0 * 6.0 + 6.0 * 3.0 / 2)
     assert walls[0].gross_area_m2() == pytest.approx(8.0 * 6.0)
     assert walls[1].height_m == 9.0
+
+
+def test_gable_roof_shell_overhangs_and_floats_above_the_roof():
+    walls = gable_walls(RECT, 6.0, 9.0, [1, 2, 3, 4])  # 8 m ridge along x, 6 m across
+    faces, top = gable_roof_shell_faces(walls, 0.5, 0.2, 0.01)
+    mesh = triangulate_faces(faces)
+    tm = trimesh.Trimesh(mesh.vertices_m, mesh.faces, process=False)
+    assert tm.is_watertight and tm.is_winding_consistent
+    cos = 3.0 / np.hypot(3.0, 3.0)
+    # Cross-section: two strips 3.5 m wide (horizontally) and 0.2 / cos thick (vertically).
+    # rel 1e-8: the slab's irrational corners are rounded to 1 nm when vertices merge.
+    assert tm.volume == pytest.approx(2 * 3.5 * 0.2 / cos * 9.0, rel=1e-8)
+    assert top == pytest.approx(9.0 + 0.21 / cos)
+    np.testing.assert_allclose(tm.bounds[:, :2], [[-4.5, -3.5], [4.5, 3.5]], atol=1e-12)
+    # 1 cm above the roof plane over the eaves wall (y = -3): z = 6 + 0.01 / cos.
+    assert tm.bounds[0, 2] == pytest.approx(6.0 + 0.01 / cos - 0.5)
+    with pytest.raises(ValueError, match="must be > 0"):
+        gable_roof_shell_faces(walls, 0.5, 0.0, 0.01)
 
 
 def test_offset_ring_of_a_rectangle():

@@ -1,11 +1,17 @@
 """The house: gable walls in closed form, the chimney as its own closed body."""
 
+import numpy as np
 import pytest
 from building_checks import check_closed_bodies
 
 from dataset.classes import SemanticClass
 from dataset.realistic import RealisticParams, make_realistic
-from dataset.realistic_house import CHIMNEY_ABOVE_RIDGE_M, house_layout
+from dataset.realistic_house import (
+    CHIMNEY_ABOVE_RIDGE_M,
+    ROOF_SHELL_GAP_M,
+    ROOF_SHELL_THICKNESS_M,
+    house_layout,
+)
 
 
 def test_house_facades_and_roof_are_closed_form():
@@ -13,7 +19,10 @@ def test_house_facades_and_roof_are_closed_form():
                         roof_m=5.0)
     t = make_realistic(p).truth
     eave, rise = 9.0, 5.0
-    assert t.height_m == pytest.approx(eave + rise)
+    cos = 4.5 / np.hypot(4.5, rise)  # of the roof pitch
+    shell = (ROOF_SHELL_GAP_M + ROOF_SHELL_THICKNESS_M) / cos
+    assert t.height_m == pytest.approx(eave + rise + shell)
+    assert t.extra["roof"]["ridge_height_m"] == pytest.approx(eave + rise)
     south, east, north, west = t.facades
     assert south.facade_area_m2 == pytest.approx(12.0 * eave)
     assert east.facade_area_m2 == pytest.approx(9.0 * eave + 9.0 * rise / 2)
@@ -25,14 +34,15 @@ def test_house_facades_and_roof_are_closed_form():
     assert len(sizes) >= 3
     assert t.extra["roof"]["kind"] == "gable"
     assert t.extra["chimney_top_m"] == pytest.approx(eave + rise + CHIMNEY_ABOVE_RIDGE_M)
+    assert t.extra["chimney_top_m"] > t.height_m
 
 
-def test_chimney_is_a_separate_closed_body_above_the_ridge():
+def test_chimney_and_roof_slab_are_separate_closed_bodies():
     building = make_realistic(RealisticParams("house"))
-    assert check_closed_bodies(building) == 2
-    mesh = building.mesh
+    assert check_closed_bodies(building) == 3  # house, roof slab, chimney
+    mesh, t = building.mesh, building.truth
     other = mesh.face_label == SemanticClass.OTHER
     top = mesh.triangles_m[other][..., 2].max()
-    assert top == pytest.approx(building.truth.height_m + CHIMNEY_ABOVE_RIDGE_M)
+    assert top == pytest.approx(t.extra["roof"]["ridge_height_m"] + CHIMNEY_ABOVE_RIDGE_M)
     roof = mesh.face_label == SemanticClass.ROOF
-    assert mesh.triangles_m[roof][..., 2].max() == pytest.approx(building.truth.height_m)
+    assert mesh.triangles_m[roof][..., 2].max() == pytest.approx(t.height_m)
