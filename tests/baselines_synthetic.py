@@ -3,6 +3,7 @@
 The facade is the plane y = 0, x in [0, L], z in [0, H], facing -y (the
 building is at y > 0). Windows are axis-aligned rectangles (x0, z0, x1, z1) in
 it; their glass may be recessed by ``recess_m`` (the reveal reads as window).
+With ``gable_m`` > 0 a triangular gable of that height tops the facade.
 An optional neighbour facade at x = L, y in [0, neighbour_m], faces +x, and the
 ground z = 0 is background with depth. Every image comes from ray-plane
 intersections through pixel centres (dataset.camera.rays_world), so it is exact.
@@ -35,13 +36,14 @@ def window_grid(length_m: float, height_m: float, cols: int, rows: int, width_m:
     return out
 
 
-def true_wwr(length_m, height_m, windows) -> float:
-    return sum((x1 - x0) * (z1 - z0) for x0, z0, x1, z1 in windows) / (length_m * height_m)
+def true_wwr(length_m, height_m, windows, gable_m: float = 0.0) -> float:
+    area = length_m * height_m + 0.5 * length_m * gable_m
+    return sum((x1 - x0) * (z1 - z0) for x0, z0, x1, z1 in windows) / area
 
 
 def render_facade(intrinsics: Intrinsics, world_from_camera: np.ndarray, *, length_m: float,
                   height_m: float, windows, recess_m: float = 0.0,
-                  neighbour_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                  neighbour_m: float = 0.0, gable_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """(H, W) uint8 labels and (H, W) float64 z-depth (m, 0 = none) of the facade scene."""
     o, d = rays_world(intrinsics, world_from_camera)
     hw = d.shape[:2]
@@ -55,8 +57,9 @@ def render_facade(intrinsics: Intrinsics, world_from_camera: np.ndarray, *, leng
         # front facade y = 0
         t = -o[..., 1] / d[..., 1]
         p = o + t[..., None] * d
+        top = height_m + gable_m * (1 - np.abs(2 * p[..., 0] / length_m - 1))
         on = (t > 0) & (p[..., 0] >= 0) & (p[..., 0] <= length_m) & (p[..., 2] >= 0) & (
-            p[..., 2] <= height_m)
+            p[..., 2] <= top)
         hit = on & (t < depth)
         depth[hit] = t[hit]
         labels[hit] = SemanticClass.WALL

@@ -3,7 +3,13 @@
 import numpy as np
 import pytest
 
-from baselines.backproject import corners_camera_m, facade_size_m
+from baselines.backproject import (
+    corner_angles_deg,
+    corners_camera_m,
+    facade_size_m,
+    image_from_camera_uv,
+    upright_rectangle_m,
+)
 from baselines.plane import Plane, plane_through_points
 from baselines.views import ViewError
 from dataset.camera import Intrinsics, look_at, project_world_to_image
@@ -40,3 +46,37 @@ def test_edge_on_plane_and_bad_shapes_are_refused():
         corners_camera_m(corners[:3], edge_on, k)
     with pytest.raises(ViewError, match="degenerate"):
         facade_size_m(np.zeros((4, 3)))
+
+
+def test_corner_angles_of_a_rectangle_and_a_trapezoid():
+    rect = np.array([[0, 9, 0], [12, 9, 0], [12, 0, 0], [0, 0, 0.0]])
+    np.testing.assert_allclose(corner_angles_deg(rect), 90.0)
+    trapezoid = np.array([[3, 3, 0], [6, 3, 0], [9, 0, 0], [0, 0, 0.0]])
+    np.testing.assert_allclose(corner_angles_deg(trapezoid), [135, 135, 45, 45])
+
+
+def test_upright_rectangle_encloses_a_gable_facade():
+    # Pentagon 10 m wide, eaves at 6 m, ridge at 9 m, in the plane y = 0, seen
+    # obliquely; its outline's bounding rectangle is 10 m x 9 m, upright.
+    k = Intrinsics.from_fov(320, 240, 60.0)
+    pose = look_at([12.0, -14.0, 1.6], [5.0, 0.0, 4.5])
+    s = np.linspace(0, 1, 200)[:, None]
+    outline = np.concatenate([
+        [0, 0, 0] + s * [10, 0, 0], [10, 0, 0] + s * [0, 0, 6], [10, 0, 6] + s * [-5, 0, 3],
+        [5, 0, 9] + s * [-5, 0, -3], [0, 0, 6] + s * [0, 0, -6]])
+    uv, _ = project_world_to_image(outline, k, pose)
+    camera_from_world = np.linalg.inv(pose)
+    cam = outline @ camera_from_world[:3, :3].T + camera_from_world[:3, 3]
+    plane = plane_through_points(cam[[0, 250, 600]])
+    up_camera = pose[:3, :3].T @ [0, 0, 1.0]
+    corners = upright_rectangle_m(uv, plane, k, up_camera)
+    # Half-pixel squares around each outline point: within a few cm at this range.
+    length, height = facade_size_m(corners)
+    assert length == pytest.approx(10.0, abs=0.1) and height == pytest.approx(9.0, abs=0.1)
+    np.testing.assert_allclose(corner_angles_deg(corners), 90.0, atol=1e-9)
+    world = corners @ pose[:3, :3].T + pose[:3, 3]
+    np.testing.assert_allclose(world[[0, 1], 2], 9.0, atol=0.1)  # the top edge is level
+    uv_back = image_from_camera_uv(corners, k)
+    assert uv_back[0, 0] < uv_back[1, 0] and uv_back[0, 1] < uv_back[3, 1]  # TL is top-left
+    with pytest.raises(ViewError, match="horizontal"):
+        upright_rectangle_m(uv, plane, k, plane.normal)

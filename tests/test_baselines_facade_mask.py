@@ -12,7 +12,7 @@ from baselines.facade_mask import (
     isolate_facade_on_plane,
 )
 from baselines.views import ViewError
-from dataset.camera import Intrinsics
+from dataset.camera import Intrinsics, look_at
 
 L_M, H_M = 12.0, 9.0
 K = Intrinsics.from_fov(256, 256, 60.0)
@@ -77,3 +77,24 @@ def test_plane_isolation_refuses_views_without_facade_or_depth():
         isolate_facade_on_plane(labels, np.zeros_like(depth), K, cfg, rng)
     with pytest.raises(ValueError, match="centre_fraction"):
         PlaneIsolationConfig(centre_fraction=0.0)
+
+
+def test_plane_isolation_prefers_the_facade_at_the_centre_over_a_bigger_neighbour():
+    # Aimed near the corner from far to the side: the 30 m neighbour fills more
+    # of the central box than the target facade, which still holds the centre.
+    pose = look_at([26.0, -10.0, 1.6], [11.2, 0.0, 4.5])
+    labels, depth = render_facade(K, pose, length_m=L_M, height_m=H_M, windows=[],
+                                  neighbour_m=30.0)
+    front = facade_class_mask(render_facade(K, pose, length_m=L_M, height_m=H_M, windows=[])[0])
+    central = np.zeros_like(front)
+    central[64:192, 64:192] = True
+    assert (facade_class_mask(labels) & ~front & central).sum() > (front & central).sum()
+    target_normal = pose[:3, :3].T @ [0.0, -1.0, 0.0]
+    rng = np.random.default_rng(0)
+    mask, plane = isolate_facade_on_plane(labels, depth, K, PlaneIsolationConfig(), rng)
+    np.testing.assert_allclose(plane.normal, target_normal, atol=1e-3)
+    assert (mask & ~front).sum() <= front.any(axis=1).sum()
+    # Without the anchor (every wall pixel may seed), RANSAC takes the neighbour.
+    _, free = isolate_facade_on_plane(labels, depth, K, PlaneIsolationConfig(
+        anchor_points=10**6), np.random.default_rng(0))
+    assert not np.allclose(free.normal, target_normal, atol=1e-3)

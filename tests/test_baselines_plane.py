@@ -60,3 +60,16 @@ def test_bad_inputs_say_what_is_wrong():
     edge_on = plane_through_points(np.array([[1.0, 0, 0], [1, 1, -1], [1, 0, -5]]))  # x = 1
     with pytest.raises(ValueError, match="edge-on"):
         intersect_rays_plane(np.array([[32.0, 24.0]]), edge_on, k)
+
+
+def test_anchored_ransac_finds_the_smaller_plane_through_the_anchors():
+    rng = np.random.default_rng(3)
+    small = _plane_points(rng, 100)  # z = -10 + 0.5 x
+    x, y = rng.uniform(-5, 5, (2, 400))
+    big = np.stack([x, y, -14 - 0.5 * x], axis=-1)  # another plane, four times the support
+    pts = np.concatenate([small, big])
+    free = fit_plane_ransac(pts, threshold_m=0.01, iterations=64, rng=rng)
+    np.testing.assert_allclose(free.signed_distance_m(big), 0, atol=1e-9)
+    anchored = fit_plane_ransac(pts, threshold_m=0.01, iterations=64, rng=rng,
+                                anchor_points_m=small[:5])
+    np.testing.assert_allclose(anchored.signed_distance_m(small), 0, atol=1e-9)

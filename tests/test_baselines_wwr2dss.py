@@ -141,3 +141,18 @@ def test_cli_fails_cleanly_when_nothing_is_left(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "nothing left to measure: facade 1: no usable view" in err and "Traceback" not in err
     assert not (tmp_path / "r").exists()
+
+
+def test_gable_facade_gets_its_upright_bounding_rectangle():
+    # 10 m wide, eaves at 6 m, ridge at 9 m: the 3D quadrilateral is no
+    # rectangle, so 2D-SS measures the upright bounding rectangle (10 m x 9 m);
+    # the WWR counts facade pixels only, so the gable's empty corners do not dilute it.
+    wins = window_grid(10.0, 6.0, 3, 2, 1.4, 1.3)
+    pose = facade_pose(10.0, 7.5, distance_m=17.0, azimuth_deg=30.0)
+    labels, depth = render_facade(K, pose, length_m=10.0, height_m=6.0, windows=wins,
+                                  gable_m=3.0)
+    g, wwr, _ = _measure(labels, depth, pose, K)
+    assert g.corners_from == "upright_rectangle"
+    assert g.length_m == pytest.approx(10.0, rel=L_TOL)
+    assert g.height_m == pytest.approx(9.0, rel=L_TOL)
+    assert wwr == pytest.approx(true_wwr(10.0, 6.0, wins, gable_m=3.0), abs=WWR_TOL)
