@@ -4,6 +4,7 @@ import itertools
 
 import numpy as np
 import pytest
+import trimesh
 
 from dataset.camera import Intrinsics, look_at, project_world_to_image
 from dataset.cameras import (
@@ -14,7 +15,10 @@ from dataset.cameras import (
     orbit_view_failures,
     sample_orbit_views,
 )
+from dataset.classes import SemanticClass
+from dataset.mesh import LabelledMesh, concatenate_meshes
 from dataset.render import Raycaster, render_ground_truth
+from dataset.truth import Building
 
 K = Intrinsics.from_fov(128, 128, 60.0)
 
@@ -115,6 +119,23 @@ def test_multi_views_five_per_facade_pairwise_distinct(box_building, box_raycast
     again = multi_views(box_building, box_raycaster, K, config=config, seed=3)
     np.testing.assert_array_equal(np.array([p for _, p in views]),
                                   np.array([p for _, p in again]))
+
+
+def test_hidden_facade_gets_no_views_and_a_warning(box_building):
+    # A 30 m x 12 m screen 3 m in front of facade 1 (y = -6) hides it from every view.
+    screen = trimesh.creation.box([30.0, 0.2, 12.0])
+    screen.apply_translation([0.0, -9.0, 6.0])
+    mesh = concatenate_meshes([box_building.mesh, LabelledMesh(
+        screen.vertices, screen.faces, [SemanticClass.OTHER] * 12, [0] * 12)])
+    building = Building(mesh, box_building.truth)
+    rc = Raycaster(mesh)
+    config = FacadeViewConfig(max_attempts=4)
+    with pytest.warns(UserWarning, match="facade 1 gets no ideal view"):
+        ideal = ideal_views(building, rc, K, config=config)
+    assert [fid for fid, _ in ideal] == [2, 3, 4]
+    with pytest.warns(UserWarning, match="facade 1 multi view"):
+        multi = multi_views(building, rc, K, config=config, seed=0)
+    assert {fid for fid, _ in multi} == {2, 3, 4} and len(multi) == 15
 
 
 def test_a_building_that_cannot_be_framed_is_refused(box_building, box_raycaster):
