@@ -109,7 +109,7 @@ def sample_look(seed: int, config: RgbConfig = RgbConfig()) -> Look:
         material = "brick" if rng.uniform() < 0.4 else "plaster"
     return Look(
         sun_dir=sun_dir,
-        sun_rgb=2.4 * np.array([1.0, 0.96 - 0.3 * warmth, 0.90 - 0.6 * warmth]),
+        sun_rgb=2.0 * np.array([1.0, 0.96 - 0.3 * warmth, 0.90 - 0.6 * warmth]),
         sky_zenith_rgb=np.array([0.10, 0.22, 0.62]) * rng.uniform(0.8, 1.2),
         sky_horizon_rgb=np.array([0.62, 0.70, 0.80]) * rng.uniform(0.85, 1.1),
         ground_rgb=pick(_GROUND, 0.15),
@@ -215,7 +215,7 @@ def shade(
     mean_sky = 0.5 * (look.sky_zenith_rgb + look.sky_horizon_rgb)
     mean_sky = 0.6 * mean_sky.mean() + 0.4 * mean_sky
     up_share = (0.5 + 0.5 * n_front[:, 2])[:, None]
-    ambient = 0.55 * mean_sky * up_share + 0.35 * look.ground_rgb * (1 - up_share)
+    ambient = 0.9 * mean_sky * up_share + 0.6 * look.ground_rgb * (1 - up_share)
     irradiance = look.sun_rgb * (cos_sun * lit)[:, None] + ambient
 
     cos_i = np.clip(-np.einsum("ij,ij->i", d, n_front), 0.15, 1.0)
