@@ -1,0 +1,143 @@
+"""Typed configs of the semantic neural SDF and its three presets (the one source of defaults).
+
+``paper`` follows the BuildNet3D / NeuS settings (8x256 MLP, for a GPU);
+``fast`` is the default, tuned for a 2-core CPU; ``tiny`` is for tests.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any, Literal
+
+Backbone = Literal["mlp", "grid"]
+Normals = Literal["analytic", "finite_difference"]
+PresetName = Literal["paper", "fast", "tiny"]
+PRESETS: tuple[str, ...] = ("paper", "fast", "tiny")
+
+
+@dataclass(frozen=True)
+class FieldConfig:
+    """Architecture of the SDF, colour, semantic and background networks.
+
+    Lengths are in the normalised frame, where the scene box's longest half-side is 1.
+    """
+
+    backbone: Backbone = "grid"
+    feature_dim: int = 32  # geometry feature passed to the colour and semantic heads
+    init_radius: float = 0.5  # geometric initialisation: SDF of a sphere of this radius
+    normals: Normals = "analytic"
+    fd_step: float = 1e-3  # finite-difference step when normals == "finite_difference"
+    # mlp backbone (NeuS / the paper)
+    mlp_hidden: int = 256
+    mlp_layers: int = 8
+    mlp_skip: int = 4
+    mlp_frequencies: int = 6
+    # grid backbone: multi-resolution grid, dense while a level fits the table, hashed above
+    grid_levels: int = 12
+    grid_features: int = 2
+    grid_min_res: int = 16
+    grid_max_res: int = 256
+    grid_log2_table: int = 18
+    grid_hidden: int = 64
+    grid_coarse_to_fine_steps: int = 1000  # iterations until every level is switched on
+    grid_start_levels: int = 4
+    # heads
+    colour_hidden: int = 64
+    colour_layers: int = 2
+    semantic_hidden: int = 128
+    view_frequencies: int = 4
+    background_hidden: int = 64
+    init_inv_s: float = 20.0  # NeuS inverse standard deviation at the start (learnt, log scale)
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Everything one training run depends on; ``config.json`` of a run is this, as JSON."""
+
+    model: FieldConfig = FieldConfig()
+    iterations: int = 3000
+    rays_per_batch: int = 1024
+    lr: float = 5e-3
+    lr_final_factor: float = 0.05  # cosine decay ends at lr * this
+    warmup: int = 100
+    samples_uniform: int = 32
+    samples_importance: int = 32
+    upsample_steps: int = 2
+    cos_anneal_steps: int = 0  # NeuS cos-anneal length; 0 = no annealing
+    rgb_weight: float = 1.0
+    eikonal_weight: float = 0.1
+    semantic_weight: float = 0.5
+    mask_weight: float = 0.1  # silhouette term from the background class (0 = off)
+    depth_loss: bool = False  # variant: supervise rendered depth with the depth images
+    depth_weight: float = 0.1
+    image_scale: float = 1.0  # images are resized by this factor on load
+    scene_box_margin: float = 0.1  # fraction of the visual-hull box added on each side
+    eval_every: int = 500
+    eval_max_frames: int = 4
+    checkpoint_every: int = 500
+    seed: int = 0
+    compile: bool = False  # torch.compile the fields (compile time counts against short runs)
+
+    def __post_init__(self) -> None:
+        positive = ("iterations", "rays_per_batch", "samples_uniform", "eval_every",
+                    "checkpoint_every", "eval_max_frames")
+        for name in positive:
+            if getattr(self, name) <= 0:
+                raise ValueError(f"TrainConfig.{name} must be positive, got {getattr(self, name)}")
+        if self.lr <= 0 or not 0 < self.image_scale <= 1:
+            raise ValueError(
+                f"TrainConfig needs lr > 0 and 0 < image_scale <= 1, got lr={self.lr}, "
+                f"image_scale={self.image_scale}"
+            )
+        if self.model.backbone not in ("mlp", "grid"):
+            raise ValueError(f"unknown backbone {self.model.backbone!r}; use 'mlp' or 'grid'")
+        if self.model.normals not in ("analytic", "finite_difference"):
+            raise ValueError(
+                f"unknown normals {self.model.normals!r}; use 'analytic' or 'finite_difference'"
+            )
+
+
+def preset_config(name: PresetName) -> TrainConfig:
+    """The config of preset ``name``: ``paper``, ``fast`` (the default) or ``tiny``."""
+    if name == "paper":
+        return TrainConfig(
+            model=FieldConfig(backbone="mlp", feature_dim=256, colour_hidden=256,
+                              colour_layers=4, init_inv_s=7.4),
+            iterations=100_000, rays_per_batch=2048, lr=5e-4, warmup=5000,
+            samples_uniform=64, samples_importance=64, upsample_steps=4,
+            cos_anneal_steps=50_000, mask_weight=0.0,
+            eval_every=5000, checkpoint_every=5000,
+        )
+    if name == "fast":
+        return TrainConfig()
+    if name == "tiny":
+        return TrainConfig(
+            model=FieldConfig(grid_levels=6, grid_max_res=64, grid_log2_table=15,
+                              grid_coarse_to_fine_steps=50, grid_start_levels=3,
+                              colour_hidden=32, colour_layers=2, semantic_hidden=32,
+                              feature_dim=16, grid_hidden=32),
+            iterations=200, rays_per_batch=256, samples_uniform=24, samples_importance=16,
+            warmup=10, eval_every=100, checkpoint_every=100, eval_max_frames=2,
+        )
+    raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
+
+
+def config_to_dict(config: TrainConfig) -> dict[str, Any]:
+    """Plain JSON-able dict of ``config`` (nested ``model``)."""
+    return asdict(config)
+
+
+def config_from_dict(d: dict[str, Any]) -> TrainConfig:
+    """Inverse of :func:`config_to_dict`; unknown keys raise ``ValueError``."""
+    d = dict(d)
+    model = d.pop("model", {})
+    _check_keys(FieldConfig, model)
+    _check_keys(TrainConfig, d)
+    return replace(TrainConfig(**d), model=FieldConfig(**model))
+
+
+def _check_keys(cls: type, d: dict[str, Any]) -> None:
+    known = {f.name for f in fields(cls)}
+    unknown = set(d) - known
+    if unknown:
+        raise ValueError(f"unknown {cls.__name__} keys {sorted(unknown)}; known: {sorted(known)}")

@@ -1,0 +1,276 @@
+"""Train the semantic SDF on one scene: ``python -m neural3d.train --scene DIR``.
+
+Run folder ``<out>/<scene name>/``: config.json, run.json (scene, normalisation,
+device, code version), checkpoint.pt (atomic; every ``checkpoint_every`` steps,
+at the end and on Ctrl-C), log.csv, eval.json. ``--resume`` continues from the
+checkpoint and matches an uninterrupted run (optimizer, scheduler and random
+generator states are restored).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import math
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from functools import partial
+from pathlib import Path
+
+import torch
+from tqdm import tqdm
+
+from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.results import code_version
+from dataset.scene import read_scene
+from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
+from neural3d.config import PRESETS, TrainConfig, config_from_dict, config_to_dict, preset_config
+from neural3d.data import (
+    background_class,
+    frames_to_pixels,
+    load_frames,
+    scene_name,
+    scene_normalisation,
+)
+from neural3d.device import resolve_device
+from neural3d.evaluate import evaluate
+from neural3d.losses import psnr, total_loss
+from neural3d.model import render_rays
+from neural3d.normalisation import Normalisation
+from neural3d.trained import TrainedField, build_field
+
+LOG_EVERY = 10  # steps between log.csv rows
+LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "depth", "psnr",
+              "inv_s", "lr")
+
+Callback = Callable[[int, TrainedField], "bool | None"]
+
+
+def lr_factor(step: int, config: TrainConfig) -> float:
+    """Learning-rate multiplier: linear warm-up, then cosine decay to ``lr_final_factor``."""
+    if step < config.warmup:
+        return (step + 1) / config.warmup
+    progress = min((step - config.warmup) / max(config.iterations - config.warmup, 1), 1.0)
+    return config.lr_final_factor + (1 - config.lr_final_factor) * 0.5 * (
+        1 + math.cos(math.pi * progress))
+
+
+def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.device,
+          resume: bool = False, max_seconds: float | None = None,
+          callback: Callback | None = None) -> Path:
+    """Train on the scene's ``train`` frames; returns the run folder ``out_dir/<scene name>``.
+
+    ``max_seconds`` stops after that much training time (a checkpoint is written);
+    ``callback(step, field)`` runs every ``config.eval_every`` steps and stops
+    training when it returns True. Time spent in evaluation and callbacks is not
+    counted as training time (``train_s`` in log.csv).
+
+    Raises
+    ------
+    ValueError
+        On an unusable scene (no train frames, mismatched image sizes, ...), an
+        unavailable device, or ``resume`` without a checkpoint or with another config.
+    """
+    device = resolve_device(device)
+    scene_dir = Path(scene_dir)
+    scene = read_scene(scene_dir)
+    run_dir = Path(out_dir) / scene_name(scene_dir)
+    bg = background_class(scene)
+    frames = load_frames(scene, "train", image_scale=config.image_scale,
+                         with_depth=config.depth_loss)
+    if resume:
+        norm = _check_resumable(run_dir, config)
+    else:
+        norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
+        _start_run_folder(run_dir, scene_dir, scene.semantic_classes, bg, norm, config, device,
+                          len(frames))
+    pixels = frames_to_pixels(frames, norm, device)
+    eval_pixels = None
+    eval_frames = scene.frames_in("eval")
+    if eval_frames:
+        chosen = load_frames(scene, "eval", image_scale=config.image_scale)
+        pick = torch.linspace(0, len(chosen) - 1, min(config.eval_max_frames, len(chosen)))
+        eval_pixels = frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device)
+
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(config.seed)
+        field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
+    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
+    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor, config=config))
+    gen = torch.Generator(device=device).manual_seed(config.seed)
+    step, train_s, log_rows, evals = 0, 0.0, [], []
+    if resume:
+        state = read_checkpoint(run_dir / CHECKPOINT_NAME, device)
+        field.load_state_dict(state["field"])
+        optimizer.load_state_dict(state["optimizer"])
+        scheduler.load_state_dict(state["scheduler"])
+        gen.set_state(state["generator"].cpu())
+        step, train_s = int(state["step"]), float(state["train_s"])
+        log_rows = [r for r in _read_log(run_dir) if int(r["step"]) <= step]
+        evals = [e for e in _read_evals(run_dir) if e["step"] <= step]
+    box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
+    box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
+    classes = tuple(scene.semantic_classes)
+
+    def save() -> None:
+        write_checkpoint(run_dir / CHECKPOINT_NAME, {
+            "step": step, "field": field.state_dict(), "optimizer": optimizer.state_dict(),
+            "scheduler": scheduler.state_dict(), "generator": gen.get_state(),
+            "train_s": train_s,
+        })
+        _write_log(run_dir, log_rows)
+
+    bar = tqdm(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
+               dynamic_ncols=True, disable=None)
+    try:
+        while step < config.iterations:
+            tic = time.perf_counter()
+            field.set_step(step)
+            idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=gen,
+                                device=device)
+            out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max,
+                              config, step=step, training=True, background_class=bg,
+                              generator=gen)
+            depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
+            loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
+                                     background_class=bg, depth_t=depth_t)
+            optimizer.zero_grad(set_to_none=True)
+            loss.backward()
+            optimizer.step()
+            scheduler.step()
+            step += 1
+            train_s += time.perf_counter() - tic
+            bar.update(1)
+            if step % LOG_EVERY == 0 or step == config.iterations:
+                row = {"step": step, "train_s": round(train_s, 3), "loss": float(loss), **parts,
+                       "psnr": psnr(out.rgb.detach(), pixels.rgb[idx]),
+                       "inv_s": float(field.inv_s()), "lr": scheduler.get_last_lr()[0]}
+                log_rows.append(row)
+                bar.set_postfix(loss=f"{row['loss']:.4f}", psnr=f"{row['psnr']:.2f}")
+            stop = max_seconds is not None and train_s >= max_seconds
+            if step % config.checkpoint_every == 0:
+                save()
+            if step % config.eval_every == 0 or step == config.iterations or stop:
+                if eval_pixels is not None:
+                    figures = evaluate(field, eval_pixels, box_min, box_max, config, step=step,
+                                       background_class=bg)
+                    evals.append({"step": step, "train_s": round(train_s, 3), **figures})
+                    write_json_atomic(run_dir / "eval.json", {"evaluations": evals})
+                if callback is not None:
+                    field.eval()
+                    answer = callback(step, TrainedField(field, norm, scene_dir=scene_dir,
+                                                         class_names=classes))
+                    field.train()
+                    stop = stop or answer is True
+            if stop:
+                break
+    except KeyboardInterrupt:
+        save()
+        raise
+    finally:
+        bar.close()
+    save()
+    return run_dir
+
+
+def _start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
+                      norm: Normalisation, config: TrainConfig, device: torch.device,
+                      n_train: int) -> None:
+    run_dir.mkdir(parents=True, exist_ok=True)
+    for stale in (CHECKPOINT_NAME, "log.csv", "eval.json"):
+        (run_dir / stale).unlink(missing_ok=True)
+    write_json_atomic(run_dir / "config.json", config_to_dict(config))
+    write_json_atomic(run_dir / "run.json", {
+        "scene_dir": str(scene_dir.resolve()), "scene_name": scene_name(scene_dir),
+        "class_names": list(classes), "background_class": bg,
+        "normalisation": norm.to_json_dict(), "device": str(device),
+        "code_version": code_version(), "torch_version": torch.__version__,
+        "train_frames": n_train,
+    })
+
+
+def _check_resumable(run_dir: Path, config: TrainConfig) -> Normalisation:
+    for name in ("config.json", "run.json", CHECKPOINT_NAME):
+        if not (run_dir / name).is_file():
+            raise ValueError(f"cannot resume: {run_dir / name} does not exist (train without "
+                             "--resume first)")
+    saved = config_from_dict(json.loads((run_dir / "config.json").read_text()))
+    if saved != config:
+        raise ValueError(f"cannot resume: {run_dir} was trained with another config; resume "
+                         "with the config in its config.json")
+    run = json.loads((run_dir / "run.json").read_text())
+    return Normalisation.from_json_dict(run["normalisation"])
+
+
+def _write_log(run_dir: Path, rows: list[dict]) -> None:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=LOG_FIELDS, restval="", extrasaction="ignore")
+    writer.writeheader()
+    writer.writerows(rows)
+    write_text_atomic(run_dir / "log.csv", buf.getvalue())
+
+
+def _read_log(run_dir: Path) -> list[dict]:
+    path = run_dir / "log.csv"
+    if not path.is_file():
+        return []
+    with path.open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _read_evals(run_dir: Path) -> list[dict]:
+    path = run_dir / "eval.json"
+    return json.loads(path.read_text())["evaluations"] if path.is_file() else []
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m neural3d.train",
+        description="Train the semantic neural SDF on a scene's train frames (RGB + semantic "
+                    "masks + poses). Writes <out>/<scene name>/ with config.json, run.json, "
+                    "checkpoint.pt, log.csv and eval.json.")
+    parser.add_argument("--scene", type=Path, required=True, help="scene folder "
+                        "(transforms.json with split='train' frames)")
+    parser.add_argument("--preset", choices=PRESETS, default=None,
+                        help="paper (8x256 MLP, GPU), fast (grid, default) or tiny (tests)")
+    parser.add_argument("--out", type=Path, default=Path("runs/neural3d"),
+                        help="folder of run folders (default runs/neural3d)")
+    parser.add_argument("--device", default="cpu", help="cpu (default), cuda or cuda:N")
+    parser.add_argument("--resume", action="store_true",
+                        help="continue from the run folder's checkpoint with its saved config")
+    parser.add_argument("--max-minutes", type=float, default=None,
+                        help="stop after this many minutes of training (a checkpoint is kept)")
+    parser.add_argument("--iterations", type=int, default=None, help="override the preset")
+    parser.add_argument("--depth-loss", action="store_true",
+                        help="variant: also supervise rendered depth with the depth images")
+    args = parser.parse_args(argv)
+    try:
+        run_dir = Path(args.out) / scene_name(args.scene)
+        if args.resume and args.preset is None and (run_dir / "config.json").is_file():
+            config = config_from_dict(json.loads((run_dir / "config.json").read_text()))
+        else:
+            config = preset_config(args.preset or "fast")
+            if args.iterations is not None:
+                config = replace(config, iterations=args.iterations)
+            if args.depth_loss:
+                config = replace(config, depth_loss=True)
+        max_s = None if args.max_minutes is None else 60.0 * args.max_minutes
+        out = train(args.scene, config, args.out, device=args.device, resume=args.resume,
+                    max_seconds=max_s)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"interrupted: checkpoint saved in {run_dir}; continue with --resume",
+              file=sys.stderr)
+        return 130
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
