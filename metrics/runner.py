@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import time
+import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -125,7 +126,7 @@ def _one(
     try:
         result = spec.run(scene_dir, protocol)
     except Exception as exc:  # one failing method must not stop the comparison
-        reason = f"{type(exc).__name__}: {exc}".strip()
+        reason = f"{type(exc).__name__}: {exc}{_where(exc)}".strip()
         log(f"{scene} / {spec.name} / {protocol}: failed: {reason}")
         return Outcome(scene, spec.name, protocol, "failed", reason=reason)
     if result.scene != scene:
@@ -134,6 +135,16 @@ def _one(
         result = replace(result, wall_time_s=time.perf_counter() - start)
     path = write_result(results_dir, result)
     return Outcome(scene, spec.name, protocol, "ran", result, path=path)
+
+
+def _where(exc: BaseException) -> str:
+    """`` (at pkg/module.py:LINE)`` of the innermost frame in this project's code, or ``""``."""
+    root = Path(__file__).resolve().parent.parent
+    frames = [f for f in traceback.extract_tb(exc.__traceback__)
+              if Path(f.filename).resolve().is_relative_to(root)]
+    if not frames or frames[-1].filename == __file__:
+        return ""
+    return f" (at {Path(frames[-1].filename).resolve().relative_to(root)}:{frames[-1].lineno})"
 
 
 def _is_scene(folder: Path) -> bool:
