@@ -11,7 +11,6 @@ interrupted run resumes where it stopped.
 from __future__ import annotations
 
 import argparse
-import multiprocessing
 import shutil
 import signal
 import sys
@@ -30,6 +29,7 @@ from dataset.scene_writer import (
     plan_views,
     scene_is_finished,
 )
+from dataset.worker_pool import worker_pool
 
 __all__ = [
     "GenerateConfig",
@@ -56,7 +56,8 @@ def generate_preset(
     """Generate every building of preset ``name`` into ``out_root``; return the scene folders.
 
     Resumable: scenes already finished with this config and seed are skipped.
-    ``workers`` processes each build and render one building at a time.
+    ``workers`` processes each build and render one building at a time (a single
+    building left to do has its frames split over them instead).
 
     Raises
     ------
@@ -90,7 +91,8 @@ def generate_preset(
     with bar:
         if workers == 1 or len(todo) <= 1:
             for job in todo:
-                _generate_recipe(job, progress=progress)
+                # A lone building still uses the workers: its frames are split over them.
+                _generate_recipe(job, progress=progress, workers=workers)
                 bar.update()
         else:
             _run_pool(todo, workers, bar)
@@ -109,37 +111,20 @@ def check_writable(folder: Path) -> None:
         ) from exc
 
 
-def _generate_recipe(job: tuple, progress: bool = False) -> Path:
+def _generate_recipe(job: tuple, progress: bool = False, workers: int = 1) -> Path:
     from dataset.presets import build_building
 
     recipe, out_root, config, s = job
     building = build_building(recipe)
-    return generate_scene(building, out_root, config, seed=s, name=recipe.id, progress=progress)
+    return generate_scene(building, out_root, config, seed=s, name=recipe.id, progress=progress,
+                          workers=workers)
 
 
 def _run_pool(todo: list[tuple], workers: int, bar: tqdm) -> None:
-    pool = multiprocessing.get_context("spawn").Pool(
-        min(workers, len(todo)), initializer=_init_worker
-    )
-    try:
+    # Each worker deletes its unfinished scene folder when the pool is terminated.
+    with worker_pool(min(workers, len(todo))) as pool:
         for _ in pool.imap_unordered(_generate_recipe, todo):
             bar.update()
-        pool.close()
-    except BaseException:
-        # Workers ignore Ctrl-C; SIGTERM makes each one delete its unfinished scene.
-        pool.terminate()
-        raise
-    finally:
-        pool.join()
-
-
-def _init_worker() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, _exit_on_sigterm)
-
-
-def _exit_on_sigterm(signum: int, frame: Any) -> None:
-    raise SystemExit(128 + signum)  # unwinds atomic_directory, which removes the partial folder
 
 
 def _interrupt_on_sigterm(signum: int, frame: Any) -> None:
@@ -185,7 +170,8 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--supersampling", type=int, default=d.supersampling,
                    help="RGB anti-aliasing: rays per pixel along each axis (default 1)")
     p.add_argument("--workers", type=int, default=1,
-                   help="processes, each rendering one building at a time (default 1)")
+                   help="processes: with --preset each renders one building at a time; with "
+                        "--mesh they share the building's frames (default 1)")
     p.add_argument("--seed", type=int, default=0, help="seed for cameras and looks (default 0)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")
@@ -239,7 +225,8 @@ def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
     if scene_dir.exists() and not args.overwrite:
         raise ValueError(f"{scene_dir} holds a scene made with another config or seed; use a "
                          "new --out or --overwrite to replace it")
-    return generate_scene(building, args.out, config, seed=args.seed, progress=not args.quiet)
+    return generate_scene(building, args.out, config, seed=args.seed, progress=not args.quiet,
+                          workers=args.workers)
 
 
 if __name__ == "__main__":

@@ -88,3 +88,18 @@ def test_bad_config_and_names_are_refused(tmp_path):
         GenerateConfig(train_fraction=1.5)
     with pytest.raises(ValueError, match="plain folder name"):
         generate_scene(make_box_building(), tmp_path, SMALL, seed=0, name="../escape")
+
+
+def test_worker_processes_write_the_same_files(tmp_path):
+    box = make_box_building()
+    one = generate_scene(box, tmp_path / "one", SMALL, seed=5, progress=False)
+    two = generate_scene(box, tmp_path / "two", SMALL, seed=5, progress=False, workers=2)
+    files = sorted(p.relative_to(one) for p in one.rglob("*.png"))
+    assert len(files) == 5 * (6 + 4 + 20)
+    assert files == sorted(p.relative_to(two) for p in two.rglob("*.png"))
+    for rel in files:
+        assert (one / rel).read_bytes() == (two / rel).read_bytes(), rel
+    frames_one = json.loads((one / "transforms.json").read_text())["frames"]
+    assert frames_one == json.loads((two / "transforms.json").read_text())["frames"]
+    with pytest.raises(ValueError, match="workers"):
+        generate_scene(box, tmp_path, SMALL, seed=5, workers=0)
