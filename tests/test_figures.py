@@ -144,3 +144,36 @@ def test_mesh_views_show_the_mesh_centred():
         covered = (img != 255).any(axis=-1)
         assert covered[128, 128] and not covered[0, 0]  # building in the middle, sky in the corner
         assert 0.05 < covered.mean() < 0.8
+
+
+def test_table1_ranges_per_family(tmp_path):
+    from dataclasses import replace
+
+    from metrics_helpers import make_truth
+
+    from figures.dataset_table import table1_dataset
+
+    truths = [
+        (tmp_path / "a", replace(make_truth("a"), floors=9, height_m=27.0, wwr=0.15,
+                                 footprint_area_m2=27.4)),
+        (tmp_path / "b", replace(make_truth("b"), floors=22, height_m=46.0, wwr=0.41,
+                                 footprint_area_m2=80.0)),
+        (tmp_path / "c", replace(make_truth("c", "realistic"), floors=3)),
+    ]
+    rows = {r[0]: r for r in table1_dataset(truths).rows}
+    assert rows["skyscraper"] == ("skyscraper", 2, 0, "9–22", "27–80", "27.0–46.0", "0.15–0.41")
+    assert rows["realistic"] == ("realistic", 1, 0, "3", "100", "6.0", "0.25")
+    assert rows["all"][1:4] == (3, 0, "3–22")
+
+
+def test_display_encodings():
+    from figures.style import CLASS_RGB, colour_depth, colour_labels, colour_normals
+
+    labels = np.array([[0, 2], [5, 200]], np.uint8)
+    rgb = colour_labels(labels)
+    assert rgb[0, 1].tolist() == CLASS_RGB[2].tolist() and rgb[1, 1].tolist() == [255, 0, 255]
+    normals = np.array([[[0, 0, 0], [1, 0, 0]]], np.float32)
+    assert colour_normals(normals).tolist() == [[[0, 0, 0], [255, 128, 128]]]
+    depth = colour_depth(np.array([[0.0, 5.0, 10.0]]))
+    assert depth[0, 0].tolist() == [255, 255, 255]
+    assert depth[0, 1].sum() > depth[0, 2].sum()  # near is brighter than far
