@@ -39,6 +39,14 @@ class Raycaster:
     Vertices are shifted to the mesh's bounding-box centre before the float32
     conversion, so precision does not depend on where the building stands.
 
+    Attributes
+    ----------
+    mesh : LabelledMesh
+    bounds_m : (2, 3) float64
+        Lowest and highest vertex coordinates (world metres).
+    face_normals : (F, 3) float64
+        Outward unit normal of every face.
+
     Raises
     ------
     ValueError
