@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from dataset.facade_geometry import WallSpec
 from dataset.grid_prism import (
     RoofSpec,
     WindowSpec,
@@ -78,7 +79,7 @@ def l_shaped_footprint(params: LShapedParams) -> np.ndarray:
     return corners - np.array([lx / 2, ly / 2])
 
 
-def l_shaped_walls(params: LShapedParams):
+def l_shaped_walls(params: LShapedParams) -> list[WallSpec]:
     """The six walls with windows and doors (:func:`dataset.grid_prism.grid_prism_walls`)."""
     return grid_prism_walls(
         l_shaped_footprint(params),

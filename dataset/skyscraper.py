@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from dataset.facade_geometry import WallSpec
 from dataset.grid_prism import (
     RoofSpec,
     WindowSpec,
@@ -59,7 +60,7 @@ def skyscraper_footprint(params: SkyscraperParams) -> np.ndarray:
     return np.array([[-x, -y], [x, -y], [x, y], [-x, y]])
 
 
-def skyscraper_walls(params: SkyscraperParams):
+def skyscraper_walls(params: SkyscraperParams) -> list[WallSpec]:
     """The four walls with windows and door (:func:`dataset.grid_prism.grid_prism_walls`)."""
     cf, cs = params.columns_front, params.columns_side
     return grid_prism_walls(
