@@ -70,8 +70,11 @@ class BuildingRecipe:
             )
         if self.family != "realistic" and self.model is not None:
             raise ValueError(f"only realistic recipes take a model, got model={self.model!r}")
-        if not isinstance(self.seed, int | np.integer) or self.seed < 0:
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int | np.integer) or (
+            self.seed < 0
+        ):
             raise ValueError(f"seed must be a non-negative integer, got {self.seed!r}")
+        object.__setattr__(self, "seed", int(self.seed))  # numpy ints do not go into JSON
 
 
 def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
@@ -98,6 +101,8 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
 
 def build_building(recipe: BuildingRecipe) -> Building:
     """Mesh and exact truth of ``recipe`` (same recipe -> identical mesh and truth)."""
+    if not isinstance(recipe, BuildingRecipe):
+        raise ValueError(f"build_building needs a BuildingRecipe, got {type(recipe).__name__}")
     rng = np.random.default_rng(recipe.seed)
     if recipe.family == "skyscraper":
         params = sample_skyscraper_params(rng)

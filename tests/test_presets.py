@@ -159,6 +159,11 @@ def test_bad_recipes_and_presets_raise_helpful_errors():
         BuildingRecipe("a", "skyscraper", 1, "house")
     with pytest.raises(ValueError, match="non-negative integer"):
         BuildingRecipe("a", "skyscraper", -1)
+    with pytest.raises(ValueError, match="non-negative integer"):
+        BuildingRecipe("a", "skyscraper", 1.5)
+    assert type(BuildingRecipe("a", "skyscraper", np.int64(3)).seed) is int
+    with pytest.raises(ValueError, match="needs a BuildingRecipe"):
+        build_building("skyscraper_00")
 
 
 def test_cli_prints_ranges_and_rejects_unknown_presets(capsys):
