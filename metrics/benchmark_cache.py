@@ -10,7 +10,8 @@ DEFAULT_CACHE = Path(".cache/envelope-bench")
 
 @dataclass(frozen=True)
 class DefaultBenchmark:
-    """The preset, image size and views of the default run, chosen to fit ~10 minutes on 2 cores.
+    """The default run's benchmark (preset, image size, views, generator workers) and
+    neural3d's extraction resolution, chosen to fit ~10 minutes on 2 cores.
 
     ``root / preset`` is the benchmark folder (relative to the working folder).
     """
@@ -19,6 +20,8 @@ class DefaultBenchmark:
     root: Path = DEFAULT_CACHE
     resolution: int = 128
     views: int = 40
+    workers: int = 2
+    neural3d_resolution: int = 128
     expected_minutes: float = 10.0
 
     @property
@@ -50,5 +53,5 @@ def ensure_benchmark(benchmark: DefaultBenchmark) -> Path:
     except ImportError as exc:
         raise ValueError(f"cannot make the default benchmark: {exc}") from exc
     config = GenerateConfig(resolution=benchmark.resolution, views=benchmark.views)
-    generate_preset(benchmark.preset, benchmark.folder, config, workers=1)
+    generate_preset(benchmark.preset, benchmark.folder, config, workers=benchmark.workers)
     return benchmark.folder

@@ -258,6 +258,10 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         f"(default: {Neural3dBudget.minutes})")
     parser.add_argument("--neural3d-preset", default=Neural3dBudget.preset,
                         choices=("paper", "fast", "tiny"), help="neural3d training preset")
+    parser.add_argument("--neural3d-resolution", type=int,
+                        help="marching-cubes samples along the scene box's longest side "
+                        "(default: neural3d's own; the built-in default run uses "
+                        f"{DefaultBenchmark.neural3d_resolution})")
     parser.add_argument("--device", default="cpu",
                         help="torch device for neural3d: cpu or cuda (default: cpu)")
     parser.add_argument("--no-run", action="store_true",
@@ -272,12 +276,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         views = tuple(v.strip() for v in args.views.split(",") if v.strip())
         _check_device(args.device)
-        budget = Neural3dBudget(args.neural3d_preset, args.neural3d_minutes, args.device)
-        data = args.data
-        if data is None:
-            default = DefaultBenchmark()
+        default = DefaultBenchmark() if args.data is None else None
+        resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
+        budget = Neural3dBudget(args.neural3d_preset, args.neural3d_minutes, resolution,
+                                args.device)
+        if default is not None:
             print(default.announce(methods, budget.minutes), flush=True)
-            data = ensure_benchmark(default)
+        data = ensure_benchmark(default) if default is not None else args.data
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
         if args.no_run:

@@ -25,15 +25,19 @@ NEURAL3D_EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geoj
 
 @dataclass(frozen=True)
 class Neural3dBudget:
-    """How neural3d trains inside a comparison: preset, time limit and device."""
+    """How neural3d runs inside a comparison: training preset and time limit per building,
+    marching-cubes resolution of the extraction (``None``: neural3d's default), device."""
 
     preset: Literal["paper", "fast", "tiny"] = "fast"
     minutes: float = 2.0
+    resolution: int | None = None
     device: str = "cpu"
 
     def __post_init__(self) -> None:
         if not self.minutes > 0:
             raise ValueError(f"neural3d minutes must be > 0, got {self.minutes}")
+        if self.resolution is not None and self.resolution < 8:
+            raise ValueError(f"neural3d resolution must be >= 8, got {self.resolution}")
 
 
 def method_specs(
@@ -99,7 +103,8 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
 
     The result's config (the extraction config) gets the training config and a
     ``budget`` entry (preset, seconds), so a result trained otherwise is
-    recomputed. Training (and torch) is imported only when a run is needed.
+    recomputed; a requested resolution is checked against the stored one.
+    Training (and torch) is imported only when a run is needed.
     """
     from neural3d.config import config_to_dict, preset_config
 
@@ -119,11 +124,14 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
         device = torch.device(budget.device)
         run_dir = train(scene_dir, train_config, runs_dir, device=device,
                         max_seconds=budget.minutes * 60.0)
-        result = extract_run(run_dir, config=ExtractConfig(), device=device,
+        extract = ExtractConfig() if budget.resolution is None else ExtractConfig(
+            resolution=budget.resolution)
+        result = extract_run(run_dir, config=extract, device=device,
                              out_dir=run_dir / NEURAL3D_EXTRACT_FOLDER)
         return replace(result, config={**result.config, **extra})
 
-    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), extra, run, has_footprint=True)
+    requested = extra if budget.resolution is None else {**extra, "resolution": budget.resolution}
+    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True)
 
 
 def read_only_specs(names: tuple[str, ...], views: tuple[str, ...]) -> list[MethodSpec]:

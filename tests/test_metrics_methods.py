@@ -15,13 +15,16 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     from neural3d.config import preset_config
 
     specs = method_specs(("2D-S", "2D-SS", "neural3d"), ("ideal",), tmp_path,
-                         neural3d=Neural3dBudget("tiny", 1.5, "cpu"))
+                         neural3d=Neural3dBudget(preset="tiny", minutes=1.5, resolution=96))
     s2ds, s2dss, n3d = specs
     assert (s2ds.protocols, s2ds.config) == (("ideal",), asdict(Wwr2dsConfig()))
     assert s2dss.config == asdict(Wwr2dssConfig())
     assert n3d.protocols == ("train",) and n3d.has_footprint
     assert n3d.config["budget"] == {"preset": "tiny", "max_seconds": 90.0}
     assert n3d.config["train"] == asdict(preset_config("tiny"))
+    assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
+    (default,) = method_specs(("neural3d",), (), tmp_path)
+    assert "resolution" not in default.config
 
 
 def test_read_only_specs_never_run():
@@ -46,6 +49,8 @@ def test_bad_names(tmp_path, names, views, message):
 def test_budget_must_be_positive():
     with pytest.raises(ValueError, match="minutes must be > 0"):
         Neural3dBudget(minutes=0)
+    with pytest.raises(ValueError, match="resolution must be >= 8"):
+        Neural3dBudget(resolution=4)
 
 
 def test_default_benchmark_announces_what_it_does(tmp_path):
