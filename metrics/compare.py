@@ -282,7 +282,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                                 args.device)
         if default is not None:
             print(default.announce(methods, budget.minutes), flush=True)
-        data = ensure_benchmark(default) if default is not None else args.data
+        data = (ensure_benchmark(default) if default is not None else args.data).resolve()
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
         if args.no_run:
