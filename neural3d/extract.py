@@ -120,13 +120,14 @@ def footprint_cell_m(box_min_m: np.ndarray, box_max_m: np.ndarray, config: Extra
     return 0.5 * longest_m / (config.resolution - 1)
 
 
-def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device) -> SemanticMesh:
+def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device, *,
+                           progress: bool = False) -> SemanticMesh:
     """Marching-cubes mesh of the field over its box, with vertex classes and colours."""
     sdf = field_sdf_fn(trained, device, config.chunk_points)
     vertices_m, faces = extract_mesh(
         sdf, trained.box_min_m, trained.box_max_m, resolution=config.resolution,
         chunk_points=config.chunk_points,
-        min_component_area_fraction=config.min_component_area_fraction,
+        min_component_area_fraction=config.min_component_area_fraction, progress=progress,
     )
     labels = label_vertices(vertices_m, field_label_fn(trained, device, config.chunk_points),
                             chunk_points=config.chunk_points)
@@ -136,7 +137,8 @@ def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device)
 
 
 def measure_field(
-    trained, config: ExtractConfig, *, device: torch.device | None = None
+    trained, config: ExtractConfig, *, device: torch.device | None = None,
+    progress: bool = False,
 ) -> tuple[MethodResult, SemanticMesh]:
     """Mesh, measure and outline a trained field; nothing is written.
 
@@ -145,6 +147,7 @@ def measure_field(
     trained : neural3d.trained.TrainedField
     config : ExtractConfig (use a modest ``resolution``, e.g. 128, while training)
     device : where to evaluate the field; None takes ``trained.device`` if it has one, else CPU.
+    progress : show a progress bar over the SDF grid.
 
     Returns
     -------
@@ -159,7 +162,7 @@ def measure_field(
     """
     start = time.perf_counter()
     device = device if device is not None else getattr(trained, "device", torch.device("cpu"))
-    mesh = semantic_mesh_of_field(trained, config, device)
+    mesh = semantic_mesh_of_field(trained, config, device, progress=progress)
     m = measure_semantic_mesh(mesh.vertices_m, mesh.faces, mesh.vertex_labels,
                               config=config.measure)
     warnings: list[str] = []
@@ -193,6 +196,7 @@ def extract_run(
     config: ExtractConfig = ExtractConfig(),
     device: torch.device,
     out_dir: Path | None = None,
+    progress: bool = False,
 ) -> MethodResult:
     """Load a trained run, measure it, and write mesh.ply, footprint.geojson and the result JSON.
 
@@ -205,12 +209,20 @@ def extract_run(
     if not run_dir.is_dir():
         raise ValueError(f"run folder {run_dir} does not exist")
     out_dir = Path(out_dir) if out_dir is not None else run_dir / "extract"
-    trained = load_trained_field(run_dir, device=device)
-    result, mesh = measure_field(trained, config, device=device)
+    try:
+        trained = load_trained_field(run_dir, device=device)
+    except RuntimeError as exc:  # torch's answer to a checkpoint of another code version
+        first_line = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"cannot load the run in {run_dir}: {first_line} (was it trained "
+                         "with another version of neural3d?)") from exc
+    result, mesh = measure_field(trained, config, device=device, progress=progress)
     write_semantic_ply(out_dir / "mesh.ply", mesh.vertices_m, mesh.faces, mesh.vertex_labels,
                        mesh.vertex_rgb)
+    footprint_path = out_dir / "footprint.geojson"
     if result.footprint is not None:
-        write_json_atomic(out_dir / "footprint.geojson", result.footprint)
+        write_json_atomic(footprint_path, result.footprint)
+    else:  # a footprint from an earlier extraction would contradict this result
+        footprint_path.unlink(missing_ok=True)
     write_result(out_dir, result)
     return result
 
@@ -277,7 +289,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         result = extract_run(args.run, config=ExtractConfig(resolution=args.resolution),
-                             device=resolve_device(args.device), out_dir=args.out)
+                             device=resolve_device(args.device), out_dir=args.out,
+                             progress=True)
     except ValueError as exc:
         print(f"neural3d.extract: {exc}", file=sys.stderr)
         return 2
