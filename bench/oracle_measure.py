@@ -24,6 +24,7 @@ from shapely.geometry import shape
 
 from dataset.mesh import LabelledMesh, triangle_areas_m2
 from dataset.presets import build_building, preset_recipes
+from neural3d.facade_match import facades_by_truth
 from neural3d.footprint import footprint_from_sdf
 from neural3d.measure import MeasureConfig, measure_semantic_mesh
 from neural3d.meshing import extract_mesh, label_vertices
@@ -72,10 +73,25 @@ class OracleField:
         return self.mesh.face_label[self.sample_face[idx]].astype(np.int64)
 
 
+def _print_facades(v, f, labels, m, building, config: MeasureConfig) -> None:
+    matched, unmatched = facades_by_truth(v, f, labels, m, building.mesh, config=config)
+    for t in building.truth.facades:
+        e = matched.get(t.id)
+        est = "missing" if e is None else (
+            f"WWR {e.wwr:.3f} ({e.wwr - t.wwr:+.3f}), {e.facade_area_m2:.1f} m², "
+            f"{e.width_m:.2f} x {e.height_m:.2f} m")
+        print(f"    facade {t.id}: truth WWR {t.wwr:.3f}, {t.facade_area_m2:.1f} m², "
+              f"{t.width_m:.2f} x {t.height_m:.2f} m | {est}")
+    if unmatched:
+        print(f"    {len(unmatched)} mesh group(s) matched no truth facade")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--preset", default="tiny")
     parser.add_argument("--resolutions", type=int, nargs="+", default=[128, 256])
+    parser.add_argument("--facades", action="store_true",
+                        help="also print per-facade WWR (truth ids via neural3d.facade_match)")
     args = parser.parse_args()
     print(f"{'building':18} {'res':>4} {'voxel m':>7} {'count':>8} {'WWR':>7} {'truth':>7} "
           f"{'err':>7} {'window %':>9} {'facade %':>9} {'IoU':>6} {'s':>5}")
@@ -103,6 +119,8 @@ def main() -> int:
                       f"{100 * (m.window_area_m2 / truth.window_area_m2 - 1):>+9.1f} "
                       f"{100 * (m.facade_area_m2 / truth.facade_area_m2 - 1):>+9.1f} "
                       f"{iou:>6.4f} {seconds:>5.0f}", flush=True)
+                if args.facades:
+                    _print_facades(v, f, labels, m, building, MeasureConfig(count=count))
     return 0
 
 
