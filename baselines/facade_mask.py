@@ -26,7 +26,9 @@ from baselines.views import ViewError
 from dataset.camera import Intrinsics
 from dataset.classes import FACADE_CLASSES, SemanticClass
 
+_MIN_FIT_PIXELS = 200  # fewer sampled pixels than this: fit to every pixel instead
 _FACADE_LOOKUP = np.isin(np.arange(256), [int(c) for c in FACADE_CLASSES])  # uint8 id -> bool
+_WALL_LOOKUP = np.arange(256) == SemanticClass.WALL
 
 
 @dataclass(frozen=True)
@@ -40,6 +42,8 @@ class PlaneIsolationConfig:
     fraction of the image width and height. ``sample_points``: at most this many
     points are sampled for RANSAC. ``anchor_points``: every RANSAC plane passes
     through one of this many wall pixels nearest the image centre.
+    ``fit_stride``: the plane is fitted to every ``fit_stride``-th pixel in
+    each direction (all pixels if that leaves too few); the mask is full-resolution.
     """
 
     wall_tolerance_m: float = 0.05
@@ -49,15 +53,17 @@ class PlaneIsolationConfig:
     sample_points: int = 1500
     min_centre_points: int = 50
     anchor_points: int = 32
+    fit_stride: int = 4
 
     def __post_init__(self) -> None:
         if self.wall_tolerance_m <= 0 or self.recess_max_m < 0:
             raise ValueError("wall_tolerance_m must be > 0 and recess_max_m >= 0")
         if not 0 < self.centre_fraction <= 1:
             raise ValueError(f"centre_fraction must be in (0, 1], got {self.centre_fraction}")
-        if self.ransac_iterations < 1 or self.sample_points < 3 or self.anchor_points < 1:
+        if (self.ransac_iterations < 1 or self.sample_points < 3 or self.anchor_points < 1
+                or self.fit_stride < 1):
             raise ValueError("ransac_iterations, sample_points (>= 3) and anchor_points "
-                             "must be positive")
+                             "and fit_stride must be positive")
 
 
 def facade_class_mask(labels: np.ndarray) -> np.ndarray:
@@ -124,13 +130,12 @@ def isolate_facade_on_plane(
         If there are no facade pixels, no valid depth on them, or no plane.
     """
     facade = facade_class_mask(labels)
-    depth = np.asarray(depth_z_m)
+    depth = np.asarray(depth_z_m, dtype=np.float32)
     if depth.shape != facade.shape:
         raise ValueError(f"depth {depth.shape} and labels {facade.shape} differ in shape")
     if not facade.any():
         raise ViewError("no facade pixels (wall, window or door) in the semantic mask")
-    # Work on the facade pixels with depth only (index lists): a fraction of the image.
-    ys, xs = np.nonzero(facade & (depth > 0) & (depth < np.inf))
+    ys, xs = _fit_pixels(facade, depth, config.fit_stride)
     if len(ys) < 3:
         raise ViewError("no valid depth on the facade pixels")
     pts = _points(xs, ys, depth, intrinsics)
@@ -144,30 +149,57 @@ def isolate_facade_on_plane(
     refine = _subsample(len(ys), 4 * config.sample_points, rng)
     # Anchor the plane at the wall pixels nearest the image centre (where the
     # photographer aimed): the biggest plane in view may be a neighbour.
-    walls = np.nonzero(labels[ys, xs] == SemanticClass.WALL)[0]
-    walls = walls if len(walls) else np.arange(len(ys))
-    r2 = (xs[walls] + 0.5 - w / 2) ** 2 + (ys[walls] + 0.5 - h / 2) ** 2
-    anchors = walls[np.argsort(r2)[: config.anchor_points]]
+    ay, ax = _anchor_pixels(labels, depth, config.anchor_points)
+    anchors_m = _points(ax, ay, depth, intrinsics)
     try:
         plane = fit_plane_ransac(
             pts[sample], threshold_m=config.wall_tolerance_m,
             iterations=config.ransac_iterations, rng=rng, refine_points_m=pts[refine],
-            anchor_points_m=pts[anchors],
+            anchor_points_m=anchors_m,
         )
     except ValueError as exc:
         raise ViewError(f"no facade plane in the depth image: {exc}") from exc
-    dist = plane.signed_distance_m(pts)
-    is_wall = labels[ys, xs] == SemanticClass.WALL
-    on_plane = np.where(
-        is_wall,
-        np.abs(dist) <= config.wall_tolerance_m,
-        (dist <= config.wall_tolerance_m) & (dist >= -config.recess_max_m),
-    )
-    if not on_plane.any():
+    dist = _signed_distance_image(plane, depth, intrinsics)
+    tol = np.float32(config.wall_tolerance_m)
+    lowest = np.where(labels == SemanticClass.WALL, -tol, np.float32(-config.recess_max_m))
+    keep = facade & (depth > 0) & (dist <= tol) & (dist >= lowest)
+    if not keep.any():
         raise ViewError("no facade pixel lies on the fitted facade plane")
-    keep = np.zeros_like(facade)
-    keep[ys[on_plane], xs[on_plane]] = True
     return centre_component(keep), plane
+
+
+def _fit_pixels(facade: np.ndarray, depth: np.ndarray, stride: int) -> tuple[np.ndarray, ...]:
+    """Rows and columns of facade pixels with depth on a grid of ``stride`` (all if too few)."""
+    d = depth[::stride, ::stride]
+    ys, xs = np.nonzero(facade[::stride, ::stride] & (d > 0) & np.isfinite(d))
+    if stride > 1 and len(ys) < _MIN_FIT_PIXELS:
+        return _fit_pixels(facade, depth, 1)
+    return ys * stride, xs * stride
+
+
+def _anchor_pixels(labels: np.ndarray, depth: np.ndarray, count: int) -> tuple[np.ndarray, ...]:
+    """Rows and columns of the ``count`` wall pixels with depth nearest the image centre.
+
+    Searched in a centred window that doubles until it holds enough; facade
+    pixels of any class stand in when the view has no wall pixel with depth.
+    """
+    h, w = labels.shape
+    cy, cx = h / 2, w / 2
+    for classes in (_WALL_LOOKUP, _FACADE_LOOKUP):
+        r = 8
+        while True:
+            y0, x0 = max(0, int(cy - r)), max(0, int(cx - r))
+            window = np.s_[y0:min(h, int(cy + r) + 1), x0:min(w, int(cx + r) + 1)]
+            ys, xs = np.nonzero(classes[labels[window]] & (depth[window] > 0))
+            if len(ys) >= count or r > max(h, w):
+                break
+            r *= 2
+        if len(ys):
+            ys, xs = ys + y0, xs + x0
+            k = min(count, len(ys))
+            near = np.argpartition((ys + 0.5 - cy) ** 2 + (xs + 0.5 - cx) ** 2, k - 1)[:k]
+            return ys[near], xs[near]
+    return ys, xs  # empty: the caller's RANSAC reports it
 
 
 def _subsample(n: int, k: int, rng: np.random.Generator) -> np.ndarray:
@@ -178,3 +210,16 @@ def _subsample(n: int, k: int, rng: np.random.Generator) -> np.ndarray:
 def _points(xs: np.ndarray, ys: np.ndarray, depth: np.ndarray, k: Intrinsics) -> np.ndarray:
     uv = np.stack([xs + 0.5, ys + 0.5], axis=-1)
     return points_camera_m(uv, depth[ys, xs], k)
+
+
+def _signed_distance_image(plane: Plane, depth: np.ndarray, k: Intrinsics) -> np.ndarray:
+    """(H, W) float32 signed distance to the plane of every pixel's depth point.
+
+    The ray direction is separable in u and v, so n . dir is the sum of a row
+    and a column term: no (H, W, 3) array of directions.
+    """
+    h, w = depth.shape
+    n = plane.normal
+    col = (n[0] * (np.arange(w) + 0.5 - k.cx) / k.fx - n[2]).astype(np.float32)
+    row = (-n[1] * (np.arange(h) + 0.5 - k.cy) / k.fy).astype(np.float32)
+    return depth * (row[:, None] + col[None, :]) - np.float32(plane.offset_m)

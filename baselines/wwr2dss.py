@@ -45,7 +45,13 @@ from baselines.cli import add_common_arguments, main_guarded, run_scenes
 from baselines.corners import corners_inside_image, enclosing_quadrilateral, outer_contour_uv
 from baselines.debug import colour_labels, draw_corners, write_debug_image
 from baselines.facade_mask import PlaneIsolationConfig, isolate_facade_on_plane
-from baselines.rectify import OUTSIDE, rectangle_size_px, rectified_wwr, rectify_labels
+from baselines.rectify import (
+    OUTSIDE,
+    quadrilateral_area_px,
+    rectangle_size_px,
+    rectified_wwr,
+    rectify_labels,
+)
 from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
 from dataset.images import read_rgb
 from dataset.results import FacadeEstimate, MethodResult
@@ -59,9 +65,11 @@ class Wwr2dssConfig:
     """2D-SS options.
 
     ``weighting``: building WWR weights, "alpha" (L/H, the paper) or "area" (L H).
-    ``combine``: how the views of one facade are combined. ``canvas_px``: side of
-    the square canvas the facades are rectified onto. ``batch_size``: views
-    warped per kornia call. ``corner_margin_px``: a corner closer than this to
+    ``combine``: how the views of one facade are combined. ``rectified_scale``:
+    rectified pixels per image pixel (the rectangle has about as many pixels as
+    the facade's quadrilateral in the photo, times its square);
+    ``max_rectified_px``: cap on the rectangle's longer side. ``batch_size``:
+    views warped per kornia call. ``corner_margin_px``: a corner closer than this to
     the image border (or outside) means the facade is cut off; the view is
     skipped. ``max_corner_angle_error_deg``: largest deviation from 90 degrees
     of a corner of the back-projected quadrilateral before the upright bounding
@@ -71,8 +79,9 @@ class Wwr2dssConfig:
     weighting: Literal["alpha", "area"] = "alpha"
     combine: Combine = "mean"
     isolation: PlaneIsolationConfig = field(default_factory=PlaneIsolationConfig)
-    canvas_px: int = 512
-    batch_size: int = 32
+    rectified_scale: float = 1.0
+    max_rectified_px: int = 1024
+    batch_size: int = 8
     corner_margin_px: float = 1.0
     max_corner_angle_error_deg: float = 5.0
     seed: int = 0
@@ -82,8 +91,9 @@ class Wwr2dssConfig:
             raise ValueError(f"weighting must be 'alpha' or 'area', got {self.weighting!r}")
         if self.combine not in COMBINES:
             raise ValueError(f"combine must be one of {COMBINES}, got {self.combine!r}")
-        if self.canvas_px < 8 or self.batch_size < 1:
-            raise ValueError("canvas_px must be >= 8 and batch_size >= 1")
+        if not self.rectified_scale > 0 or self.max_rectified_px < 8 or self.batch_size < 1:
+            raise ValueError("rectified_scale must be > 0, max_rectified_px >= 8 and "
+                             "batch_size >= 1")
         if not 0 < self.max_corner_angle_error_deg <= 90:
             raise ValueError("max_corner_angle_error_deg must be in (0, 90]")
 
@@ -147,18 +157,22 @@ def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
     """
     wwr = np.full(len(geometries), np.nan)
     images: list[np.ndarray | None] = [None] * len(geometries)
-    sizes = np.array([rectangle_size_px(g.length_m / g.height_m, config.canvas_px)
-                      for g in geometries]).reshape(-1, 2)
+    sizes = np.array([
+        rectangle_size_px(g.length_m / g.height_m,
+                          quadrilateral_area_px(g.corners_uv) * config.rectified_scale**2,
+                          config.max_rectified_px)
+        for g in geometries]).reshape(-1, 2)
+    # Batches of similar size (sorted by area) share one canvas with little padding.
     by_shape: dict[tuple[int, int], list[int]] = {}
-    for i, g in enumerate(geometries):
-        by_shape.setdefault(g.view.labels.shape, []).append(i)
+    for i in np.argsort(sizes.prod(axis=1), kind="stable"):
+        by_shape.setdefault(geometries[i].view.labels.shape, []).append(int(i))
     for idx in by_shape.values():
         for start in range(0, len(idx), config.batch_size):
             batch = idx[start:start + config.batch_size]
             rect = rectify_labels(
                 np.stack([geometries[i].view.labels for i in batch]),
                 np.stack([geometries[i].corners_uv for i in batch]),
-                sizes[batch], config.canvas_px, device,
+                sizes[batch], device,
             )
             wwr[batch] = rectified_wwr(rect)
             if keep_images:

@@ -6,6 +6,7 @@ import torch
 
 from baselines.rectify import (
     OUTSIDE,
+    quadrilateral_area_px,
     rectangle_size_px,
     rectified_from_image,
     rectified_wwr,
@@ -34,10 +35,19 @@ def test_warp_uses_pixel_centres_at_half_integers():
     rng = np.random.default_rng(0)
     labels = rng.integers(0, 6, (24, 32)).astype(np.uint8)
     corners = np.array([[[0, 0], [32, 0], [32, 24], [0, 24.0]]])
-    out = rectify_labels(labels[None], corners, np.array([[64, 48]]), canvas_px=64)
-    assert out.shape == (1, 64, 64)
-    np.testing.assert_array_equal(out[0, :48], labels.repeat(2, 0).repeat(2, 1))
-    assert (out[0, 48:] == OUTSIDE).all()
+    out = rectify_labels(labels[None], corners, np.array([[64, 48]]))
+    assert out.shape == (1, 48, 64)
+    np.testing.assert_array_equal(out[0], labels.repeat(2, 0).repeat(2, 1))
+
+
+def test_a_batch_shares_the_largest_canvas_and_marks_the_rest_outside():
+    labels = np.ones((2, 24, 32), np.uint8)
+    corners = np.array([[[0, 0], [32, 0], [32, 24], [0, 24.0]]] * 2)
+    out = rectify_labels(labels, corners, np.array([[64, 48], [16, 30]]))
+    assert out.shape == (2, 48, 64)
+    assert (out[0] == 1).all()
+    assert (out[1, :30, :16] == 1).all() and (out[1, 30:] == OUTSIDE).all()
+    assert (out[1, :, 16:] == OUTSIDE).all()
 
 
 def test_rectified_translation_crops_the_quadrilateral():
@@ -45,9 +55,8 @@ def test_rectified_translation_crops_the_quadrilateral():
     labels[10:30, 5:45] = 1
     labels[15:20, 10:20] = 2
     corners = np.array([[[5, 10], [45, 10], [45, 30], [5, 30.0]]])
-    out = rectify_labels(labels[None], corners, np.array([[40, 20]]), canvas_px=40,
-                         device=torch.device("cpu"))
-    np.testing.assert_array_equal(out[0, :20], labels[10:30, 5:45])
+    out = rectify_labels(labels[None], corners, np.array([[40, 20]]), device=torch.device("cpu"))
+    np.testing.assert_array_equal(out[0], labels[10:30, 5:45])
     assert rectified_wwr(out)[0] == pytest.approx(50 / 800)
 
 
@@ -60,18 +69,26 @@ def test_rectified_wwr_counts_facade_classes_only():
     assert np.isnan(wwr[1])
 
 
-def test_rectangle_fits_the_canvas_with_its_aspect():
-    assert rectangle_size_px(2.0, 512) == (512, 256)
-    assert rectangle_size_px(0.25, 512) == (128, 512)
-    assert rectangle_size_px(1.0, 100) == (100, 100)
+def test_rectangle_keeps_the_area_and_aspect_within_the_cap():
+    assert rectangle_size_px(2.0, 20000.0, 1024) == (200, 100)
+    assert rectangle_size_px(0.25, 10000.0, 1024) == (50, 200)
+    assert rectangle_size_px(2.0, 20000.0, 100) == (100, 50)  # capped, aspect kept
+    assert rectangle_size_px(1.0, 0.01, 100) == (1, 1)
     with pytest.raises(ValueError, match="positive"):
-        rectangle_size_px(float("nan"), 512)
+        rectangle_size_px(float("nan"), 100.0, 512)
+    with pytest.raises(ValueError, match="area_px"):
+        rectangle_size_px(1.0, 0.0, 512)
+
+
+def test_quadrilateral_area_by_shoelace():
+    assert quadrilateral_area_px(np.array([[0, 0], [4, 0], [4, 3], [0, 3.0]])) == 12.0
+    assert quadrilateral_area_px(np.array([[0, 0], [4, 0], [3, 2], [1, 2.0]])) == 6.0
 
 
 def test_bad_inputs_say_what_is_wrong():
     with pytest.raises(ValueError, match=r"\(B, 4, 2\)"):
         rectified_from_image(np.zeros((4, 2)), np.ones((1, 2)))
     with pytest.raises(ValueError, match="sizes"):
-        rectify_labels(np.zeros((1, 8, 8), np.uint8), np.zeros((1, 4, 2)), np.array([[9, 4]]), 8)
+        rectify_labels(np.zeros((1, 8, 8), np.uint8), np.zeros((1, 4, 2)), np.array([[0, 4]]))
     with pytest.raises(ValueError, match=r"\(B, H, W\)"):
-        rectify_labels(np.zeros((8, 8), np.uint8), np.zeros((1, 4, 2)), np.array([[4, 4]]), 8)
+        rectify_labels(np.zeros((8, 8), np.uint8), np.zeros((1, 4, 2)), np.array([[4, 4]]))
