@@ -116,8 +116,8 @@ def preset_config(name: PresetName) -> TrainConfig:
                               grid_coarse_to_fine_steps=50, grid_start_levels=3,
                               colour_hidden=32, colour_layers=2, semantic_hidden=32,
                               feature_dim=16, grid_hidden=32),
-            iterations=200, rays_per_batch=256, samples_uniform=24, samples_importance=16,
-            warmup=10, eval_every=100, checkpoint_every=100, eval_max_frames=2,
+            iterations=150, rays_per_batch=128, samples_uniform=16, samples_importance=16,
+            warmup=10, eval_every=50, checkpoint_every=50, eval_max_frames=2,
         )
     raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
 

@@ -81,19 +81,21 @@ class GridEncoding(nn.Module):
             total += size
         self.levels, self.features = levels, features
         self.out_dim = levels * features
-        self.register_buffer("box_min", torch.tensor(lo, dtype=torch.float32))
-        self.register_buffer("box_size", torch.tensor(extent, dtype=torch.float32))
-        self.register_buffer("res", torch.tensor(np.stack(res)))  # (L, 3) int64
-        self.register_buffer("offsets", torch.tensor(offsets))  # (L,)
-        self.register_buffer("hashed", torch.tensor(hashed))  # (L,) bool
-        self.register_buffer("sizes", torch.tensor(sizes))  # (L,)
+        # Buffers derived from the config are not saved: a checkpoint holds learnt weights.
+        self.register_buffer("box_min", torch.tensor(lo, dtype=torch.float32), persistent=False)
+        self.register_buffer("box_size", torch.tensor(extent, dtype=torch.float32),
+                             persistent=False)
+        self.register_buffer("res", torch.tensor(np.stack(res)), persistent=False)  # (L, 3) int64
+        self.register_buffer("offsets", torch.tensor(offsets), persistent=False)  # (L,)
+        self.register_buffer("hashed", torch.tensor(hashed), persistent=False)  # (L,) bool
+        self.register_buffer("sizes", torch.tensor(sizes), persistent=False)  # (L,)
         self.n_dense = int(sum(not h for h in hashed))
         if any(hashed[: self.n_dense]):
             raise AssertionError("dense levels must come first")  # resolution grows per level
         strides = [[1, r[0] + 1, (r[0] + 1) * (r[1] + 1)] for r in res]
-        self.register_buffer("strides", torch.tensor(strides))  # (L, 3) dense index strides
-        self.register_buffer("primes", torch.tensor(_PRIMES))
-        self.register_buffer("two", torch.arange(2))
+        self.register_buffer("strides", torch.tensor(strides), persistent=False)  # (L, 3)
+        self.register_buffer("primes", torch.tensor(_PRIMES), persistent=False)
+        self.register_buffer("two", torch.arange(2), persistent=False)
         self.register_buffer("level_mask", torch.ones(levels), persistent=False)
         self.table = nn.Parameter(torch.empty(total, features).uniform_(-1e-4, 1e-4))
 

@@ -75,4 +75,4 @@ def total_loss(out: RenderOutput, rgb: Tensor, labels: Tensor, config: TrainConf
             raise ValueError("depth_loss is on but the batch has no depth")
         terms["depth"] = (config.depth_weight, depth_l1(out.depth, depth_t))
     total = sum(w * v for w, v in terms.values())
-    return total, {k: float(v) for k, (_, v) in terms.items()}
+    return total, {k: float(v.detach()) for k, (_, v) in terms.items()}

@@ -1,0 +1,138 @@
+"""Training on a tiny rendered box: losses fall, the level set fits, resume matches, errors."""
+
+import csv
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+from conftest import BOX_SIZE_M
+from neural3d_scene import write_ring_scene
+
+from neural3d.checkpoint import read_checkpoint
+from neural3d.config import preset_config
+from neural3d.train import lr_factor, main, train
+from neural3d.trained import load_trained_field
+
+CPU = torch.device("cpu")
+SHORT = replace(preset_config("tiny"), iterations=100, eval_every=50, checkpoint_every=50)
+# Median |SDF| on the true box surface after SHORT training: measured 0.4-0.6 m on this
+# 20 x 12 x 9 m box (32 px images, voxel-ish 0.3 m grid); bounded at 1.0 m (5 % of its length).
+SURFACE_TOL_M = 1.0
+
+
+@pytest.fixture(scope="module")
+def scene(box_building, tmp_path_factory):
+    return write_ring_scene(box_building, tmp_path_factory.mktemp("n3d") / "box", size_px=32,
+                            n_train=16, n_eval=2)
+
+
+@pytest.fixture(scope="module")
+def short_run(scene, tmp_path_factory):
+    return train(scene, SHORT, tmp_path_factory.mktemp("runs"), device=CPU)
+
+
+def box_surface_points(n, seed=0):
+    sx, sy, sz = BOX_SIZE_M
+    rng = np.random.default_rng(seed)
+    u, v = rng.random(n), rng.random(n)
+    face = rng.integers(0, 5, n)
+    x = np.where(face == 2, -sx / 2, np.where(face == 3, sx / 2, (u - 0.5) * sx))
+    y = np.where(face == 0, -sy / 2, np.where(face == 1, sy / 2,
+                 np.where(face == 4, (v - 0.5) * sy, (u - 0.5) * sy)))
+    z = np.where(face == 4, sz, v * sz)
+    return torch.tensor(np.stack([x, y, z], 1), dtype=torch.float32)
+
+
+def test_short_training_lowers_every_loss(short_run):
+    with (short_run / "log.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert int(rows[-1]["step"]) == SHORT.iterations
+    for key in ("loss", "rgb", "eikonal", "semantic", "mask"):
+        first = float(rows[0][key])
+        last = np.mean([float(r[key]) for r in rows[-3:]])
+        assert last < first, f"{key}: {first} -> {last}"
+    evals = json.loads((short_run / "eval.json").read_text())["evaluations"]
+    assert [e["step"] for e in evals] == [50, 100]
+    assert evals[-1]["semantic_accuracy"] > 0.8
+
+
+def test_zero_level_set_fits_the_box(short_run):
+    field = load_trained_field(short_run, device=CPU)
+    sdf = field.sdf_m(box_surface_points(1000))
+    print("median |sdf| on the box surface (m):", float(sdf.abs().median()))
+    assert sdf.abs().median() < SURFACE_TOL_M, sdf.abs().median()
+    sx, sy, sz = BOX_SIZE_M
+    assert field.sdf_m(torch.tensor([[0.0, 0.0, sz / 2]])) < 0
+    outside = torch.tensor([[sx / 2 + 3, 0, sz / 2], [0, -sy / 2 - 3, sz / 2]])
+    assert (field.sdf_m(outside) > 0).all()
+
+
+def test_resume_matches_uninterrupted_run(scene, tmp_path):
+    config = replace(preset_config("tiny"), iterations=6, rays_per_batch=32, eval_every=3,
+                     checkpoint_every=100)
+    straight = train(scene, config, tmp_path / "a", device=CPU)
+
+    def interrupt(step, field):
+        raise KeyboardInterrupt  # as Ctrl-C would, after step 3
+
+    with pytest.raises(KeyboardInterrupt):
+        train(scene, config, tmp_path / "b", device=CPU, callback=interrupt)
+    assert read_checkpoint(tmp_path / "b" / "box" / "checkpoint.pt", CPU)["step"] == 3
+    resumed = train(scene, config, tmp_path / "b", device=CPU, resume=True)
+    a = read_checkpoint(straight / "checkpoint.pt", CPU)
+    b = read_checkpoint(resumed / "checkpoint.pt", CPU)
+    assert a["step"] == b["step"] == 6
+    for key, value in a["field"].items():
+        assert torch.allclose(value, b["field"][key], atol=1e-6), key
+
+
+def test_callback_stops_early(scene, tmp_path):
+    config = replace(preset_config("tiny"), iterations=50, rays_per_batch=16, eval_every=2)
+    seen = []
+    run = train(scene, config, tmp_path, device=CPU, callback=lambda s, f: seen.append(s) or True)
+    assert seen == [2]
+    assert read_checkpoint(run / "checkpoint.pt", CPU)["step"] == 2
+
+
+def test_lr_schedule_warmup_then_cosine():
+    c = replace(preset_config("tiny"), iterations=110, warmup=10, lr_final_factor=0.05)
+    assert lr_factor(0, c) == pytest.approx(0.1)
+    assert lr_factor(10, c) == pytest.approx(1.0)
+    assert lr_factor(60, c) == pytest.approx(0.525)
+    assert lr_factor(110, c) == pytest.approx(0.05)
+
+
+def _edit_transforms(scene_dir, edit):
+    path = scene_dir / "transforms.json"
+    meta = json.loads(path.read_text())
+    edit(meta)
+    path.write_text(json.dumps(meta))
+
+
+def test_scene_errors(scene, tmp_path):
+    import shutil
+
+    copy = tmp_path / "copy"
+    shutil.copytree(scene, copy)
+    _edit_transforms(copy, lambda m: [f.update(split="eval") for f in m["frames"]])
+    with pytest.raises(ValueError, match="no 'train' frames"):
+        train(copy, SHORT, tmp_path / "runs", device=CPU)
+    _edit_transforms(copy, lambda m: [f.update(split="train") for f in m["frames"]])
+    _edit_transforms(copy, lambda m: m.update(w=40))
+    with pytest.raises(ValueError, match="intrinsics say 40x32"):
+        train(copy, SHORT, tmp_path / "runs", device=CPU)
+    with pytest.raises(ValueError, match="unknown device"):
+        train(scene, SHORT, tmp_path / "runs", device="tpu-9")
+    with pytest.raises(ValueError, match="cannot resume"):
+        train(scene, SHORT, tmp_path / "fresh", device=CPU, resume=True)
+
+
+def test_cli_reports_errors_in_one_line(tmp_path, capsys):
+    assert main(["--scene", str(tmp_path / "nowhere"), "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and err.count("\n") == 1
+    if not torch.cuda.is_available():
+        assert main(["--scene", str(tmp_path), "--device", "cuda"]) == 2
+        assert "CUDA is not available" in capsys.readouterr().err
