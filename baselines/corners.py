@@ -119,11 +119,15 @@ def corners_inside_image(corners: np.ndarray, width: int, height: int, margin_px
         | (c[:, 1] < margin_px) | (c[:, 1] > height - margin_px)
     )
     if bad.any():
-        where = ", ".join(f"({u:.1f}, {v:.1f})" for u, v in c[bad])
+        where = ", ".join(f"({_fmt(u)}, {_fmt(v)})" for u, v in c[bad])
         raise ViewError(
             f"facade corner(s) {where} outside or on the border of the "
             f"{width}x{height} image (the facade is cut off)"
         )
+
+
+def _fmt(x: float) -> str:
+    return f"{round(float(x), 1) + 0.0:.1f}"  # + 0.0: no "-0.0"
 
 
 def _refine_sides(quad: np.ndarray, contour: np.ndarray) -> np.ndarray:
