@@ -57,7 +57,8 @@ def building_result(
     present = [f for f in facades if not f.missing]
     warnings = list(warnings)
     if not present:
-        reasons = "; ".join(f"facade {f.id}: {f.reason}" for f in facades) or "no facade views"
+        reasons = ("; ".join(f"facade {f.id}: {f.reason}" for f in facades)
+                   or "; ".join(warnings) or "no facade views")
         raise ValueError(f"{scene} ({method}, {protocol}): nothing left to measure: {reasons}")
     missing = [f.id for f in facades if f.missing]
     if missing:

@@ -53,3 +53,8 @@ def test_areas_unavailable_when_a_facade_has_no_scale():
 def test_nothing_left_is_an_error_listing_the_reasons():
     with pytest.raises(ValueError, match="nothing left to measure: facade 3: no usable view: cut"):
         _result([missing_facade(3, ["cut off"])])
+
+
+def test_no_facade_at_all_reports_the_warnings():
+    with pytest.raises(ValueError, match="nothing left to measure: w0"):
+        _result([])
