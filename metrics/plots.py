@@ -14,6 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from dataset.atomic import write_bytes_atomic
+from dataset.results import code_version
 from metrics.aggregate import GroupSummary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
 
@@ -23,12 +24,18 @@ ERROR_PANELS = (("wwr_ape", "WWR error (%)"), ("window_ape", "Window error (%)")
 
 
 def save_figure(fig: Figure, stem: str | Path) -> list[Path]:
-    """Write ``<stem>.png`` and ``<stem>.pdf`` atomically; returns both paths."""
+    """Write ``<stem>.png`` and ``<stem>.pdf`` atomically; returns both paths.
+
+    Both files name the code version that made them in their metadata
+    (PNG ``Software``, PDF ``Creator``).
+    """
     stem = Path(stem)
+    made_by = f"envelope-bench {code_version()}"
     paths = []
-    for fmt in ("png", "pdf"):
+    for fmt, metadata in (("png", {"Software": made_by}), ("pdf", {"Creator": made_by})):
         buf = io.BytesIO()
-        fig.savefig(buf, format=fmt, dpi=PNG_DPI)  # constrained layout: no tight bbox pass
+        # Constrained layout already fits the labels: no tight-bbox pass needed.
+        fig.savefig(buf, format=fmt, dpi=PNG_DPI, metadata=metadata)
         path = stem.with_name(f"{stem.name}.{fmt}")
         write_bytes_atomic(path, buf.getvalue())
         paths.append(path)

@@ -24,6 +24,7 @@ def test_plots_write_png_and_pdf(tmp_path, plot):
     assert [p.name for p in paths] == ["p.png", "p.pdf"]
     assert paths[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert paths[1].read_bytes()[:5] == b"%PDF-"
+    assert b"envelope-bench " in paths[0].read_bytes()  # the code version in the metadata
 
 
 def test_nothing_to_plot_is_a_value_error(tmp_path):
