@@ -20,12 +20,18 @@ from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
-from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from dataset.results import code_version
 from dataset.truth import BuildingTruth, read_building
 from metrics.aggregate import aggregate_by_family
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark, ensure_benchmark
-from metrics.errors import BuildingErrors, FacadeErrors, building_errors, facade_errors
+from metrics.errors import (
+    NO_TRUTH_FAMILY,
+    BuildingErrors,
+    FacadeErrors,
+    building_errors,
+    facade_errors,
+)
 from metrics.errors import failed_building as failed_row
 from metrics.methods import (
     METHODS,
@@ -121,7 +127,7 @@ def evaluate(
     facade_rows: list[FacadeErrors] = []
     for o in outcomes:
         truth = truths.get(o.scene)
-        family = truth.type if truth is not None else "unknown"
+        family = truth.type if truth is not None else NO_TRUTH_FAMILY
         if o.result is None:
             rows.append(failed_row(o.scene, family, o.method, o.protocol, o.reason))
             continue
@@ -167,22 +173,26 @@ def _provenance(
 
 
 def _write_plots(groups, rows, folder: Path) -> None:
-    for plot, data, stem in (
-        (plot_errors_by_family, groups, "errors_by_family"),
-        (plot_wwr_scatter, rows, "wwr_scatter"),
-        (plot_iou_per_building, rows, "iou_per_building"),
-    ):
-        try:
-            plot(data, folder / stem)
-        except ValueError as exc:
-            print(f"plot {stem} skipped: {exc}", file=sys.stderr)
+    """Replace ``folder`` with this comparison's plots (a skipped plot leaves no stale file)."""
+    with atomic_directory(folder) as tmp:
+        for plot, data, stem in (
+            (plot_errors_by_family, groups, "errors_by_family"),
+            (plot_wwr_scatter, rows, "wwr_scatter"),
+            (plot_iou_per_building, rows, "iou_per_building"),
+        ):
+            try:
+                plot(data, tmp / stem)
+            except ValueError as exc:
+                print(f"plot {stem} skipped: {exc}", file=sys.stderr)
 
 
 def _write_footprints(outcomes: Sequence[Outcome], folder: Path) -> None:
-    for o in outcomes:
-        if o.result is not None and o.result.footprint is not None:
-            write_json_atomic(folder / f"{o.scene}__{o.method}__{o.protocol}.geojson",
-                              o.result.footprint)
+    """Replace ``folder`` with the estimated footprints of this comparison's results."""
+    with atomic_directory(folder) as tmp:
+        for o in outcomes:
+            if o.result is not None and o.result.footprint is not None:
+                write_json_atomic(tmp / f"{o.scene}__{o.method}__{o.protocol}.geojson",
+                                  o.result.footprint)
 
 
 def _write_neural3d_pointers(scene_dirs: Sequence[Path], results_dir: Path, out: Path) -> None:

@@ -155,3 +155,19 @@ def test_runs_the_2d_methods_on_the_tiny_benchmark_then_reuses_them(tiny_benchma
         assert main(argv) == 0
     prov = json.loads((out / "provenance.json").read_text())
     assert {r["status"] for r in prov["runs"]} == {"reused"}
+
+
+def test_a_second_comparison_leaves_no_stale_plot_or_footprint(tmp_path):
+    data, results = make_benchmark(tmp_path)
+    out = tmp_path / "out"
+    base = ["--data", str(data), "--results", str(results), "--out", str(out), "--no-run",
+            "--views", "ideal"]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(base) == 0
+        assert (out / "plots" / "iou_per_building.png").is_file()
+        (out / "notes.txt").write_text("a user's file")
+        assert main([*base, "--methods", "2D-S"]) == 0
+    assert not (out / "plots" / "iou_per_building.png").exists()
+    assert (out / "plots" / "wwr_scatter.png").is_file()
+    assert list((out / "footprints").iterdir()) == []
+    assert (out / "notes.txt").read_text() == "a user's file"  # the folder itself is kept
