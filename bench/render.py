@@ -151,6 +151,8 @@ def _tree_rss_kb(root_pid: int) -> int:
 def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--full", action="store_true", help="also run the whole paper preset")
+    p.add_argument("--full-only", action="store_true",
+                   help="run only the whole paper preset (after a quick run)")
     p.add_argument("--resolution", type=int, default=512)
     p.add_argument("--building-views", type=int, default=40,
                    help="orbit views of the whole-building run (default 40)")
@@ -159,6 +161,13 @@ def main() -> int:
     args = p.parse_args()
     res = args.resolution
     print(f"load average at start: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    if args.full_only:
+        full = preset_run("paper", GenerateConfig().views, res, workers=2)
+        print(f"\nPreset paper, default config, 2 workers: {full['frames']} frames, wall "
+              f"{full['wall_s'] / 60:.1f} min ({full['frames'] / full['wall_s']:.2f} frames/s), "
+              f"peak memory {full['peak_rss_mb']:.0f} MB; load average at end "
+              f"{os.getloadavg()[0]:.1f}")
+        return 0
 
     print(f"\nPer image, {res}x{res}, one process (median over 15 views):")
     for name, seconds in per_image(res).items():
@@ -179,7 +188,8 @@ def main() -> int:
     if args.full:
         full = preset_run("paper", GenerateConfig().views, res, workers=2)
         print(f"\nPreset paper, default config, 2 workers: {full['frames']} frames, wall "
-              f"{full['wall_s'] / 60:.1f} min, peak memory {full['peak_rss_mb']:.0f} MB")
+              f"{full['wall_s'] / 60:.1f} min ({full['frames'] / full['wall_s']:.2f} frames/s), "
+              f"peak memory {full['peak_rss_mb']:.0f} MB")
     else:
         print(f"\nPreset paper, default config ({paper_frames} frames), 2 workers: "
               f"EXTRAPOLATED from the tiny run: {paper_frames / rate / 60:.0f} min "
