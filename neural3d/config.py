@@ -76,7 +76,6 @@ class TrainConfig:
     eval_max_frames: int = 4
     checkpoint_every: int = 500
     seed: int = 0
-    compile: bool = False  # torch.compile the fields (compile time counts against short runs)
 
     def __post_init__(self) -> None:
         positive = ("iterations", "rays_per_batch", "samples_uniform", "eval_every",

@@ -148,7 +148,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             if step % LOG_EVERY == 0 or step == config.iterations:
                 row = {"step": step, "train_s": round(train_s, 3), "loss": float(loss.detach()),
                        **parts, "psnr": psnr(out.rgb.detach(), pixels.rgb[idx]),
-                       "inv_s": float(field.inv_s()), "lr": scheduler.get_last_lr()[0]}
+                       "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0]}
                 log_rows.append(row)
                 bar.set_postfix(loss=f"{row['loss']:.4f}", psnr=f"{row['psnr']:.2f}")
             stop = max_seconds is not None and train_s >= max_seconds

@@ -1,0 +1,198 @@
+"""Speed and time-to-accuracy of the semantic neural SDF; prints Markdown, writes JSON.
+
+    python bench/neural3d.py speed --scene DIR [--device cpu|cuda] [--steps 5]
+    python bench/neural3d.py converge --benchmark DIR [--minutes 30] [--check-every 100]
+
+``speed``: training iterations per second of each backbone at its preset's
+batch (``fast`` = grid, ``paper`` = mlp) and of the mlp at ``fast``'s batch,
+on one scene, after one warm-up step. Given per wall-clock second and per CPU
+second of this process: on a machine shared with other jobs the CPU figure is
+the one that does not depend on the neighbours.
+
+``converge``: trains ``fast`` on every scene folder of ``--benchmark`` (e.g. the
+tiny preset, one building per family) and every ``--check-every`` iterations
+meshes and measures the field with part 2's ``neural3d.extract.measure_field``;
+reports the training time until WWR error <= 5 % and footprint IoU >= 0.96
+(the targets), and the final figures. Measuring time is not training time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+# Run as a script, this file's folder is sys.path[0]: put the repository root there instead.
+sys.path[0] = str(Path(__file__).resolve().parent.parent)
+
+import torch  # noqa: E402
+
+from dataset.atomic import write_json_atomic  # noqa: E402
+from dataset.scene import read_scene  # noqa: E402
+from neural3d.config import TrainConfig, preset_config  # noqa: E402
+from neural3d.data import (  # noqa: E402
+    background_class,
+    frames_to_pixels,
+    load_frames,
+    scene_normalisation,
+)
+from neural3d.device import resolve_device  # noqa: E402
+from neural3d.losses import total_loss  # noqa: E402
+from neural3d.model import render_rays  # noqa: E402
+from neural3d.train import train  # noqa: E402
+from neural3d.trained import TrainedField, build_field  # noqa: E402
+
+WWR_TARGET_PCT = 5.0
+IOU_TARGET = 0.96
+
+
+def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.device,
+                          steps: int) -> tuple[float, float]:
+    """(iterations per wall second, per process CPU second) of the training step."""
+    scene = read_scene(scene_dir)
+    bg = background_class(scene)
+    frames = load_frames(scene, "train", image_scale=config.image_scale)
+    norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
+    px = frames_to_pixels(frames, norm, device)
+    torch.manual_seed(0)
+    field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
+    opt = torch.optim.Adam(field.parameters(), lr=config.lr, eps=1e-15)
+    lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
+    hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
+    gen = torch.Generator(device=device).manual_seed(0)
+
+    def step(i: int) -> None:
+        field.set_step(i)
+        idx = torch.randint(len(px), (config.rays_per_batch,), generator=gen, device=device)
+        out = render_rays(field, px.origins[idx], px.dirs[idx], lo, hi, config, step=i,
+                          training=True, background_class=bg, generator=gen)
+        loss, _ = total_loss(out, px.rgb[idx], px.labels[idx], config, background_class=bg)
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+        if device.type == "cuda":
+            torch.cuda.synchronize(device)
+
+    step(0)  # warm-up: allocator, first-call overheads
+    wall, cpu = time.perf_counter(), time.process_time()
+    for i in range(1, steps + 1):
+        step(i)
+    return steps / (time.perf_counter() - wall), steps / (time.process_time() - cpu)
+
+
+def speed(args: argparse.Namespace) -> dict:
+    device = resolve_device(args.device)
+    fast, paper = preset_config("fast"), preset_config("paper")
+    cases = {
+        "grid (fast preset)": fast,
+        "mlp (paper preset)": paper,
+        "mlp at the fast batch": replace(fast, model=paper.model),
+    }
+    rows = []
+    for name, config in cases.items():
+        per_wall, per_cpu = iterations_per_second(args.scene, config, device, args.steps)
+        samples = config.samples_uniform + config.samples_importance
+        rows.append({"case": name, "device": str(device), "rays": config.rays_per_batch,
+                     "samples": samples, "it_per_s": per_wall, "it_per_cpu_s": per_cpu})
+        print(f"| {name} | {device} | {config.rays_per_batch} | {samples} | {per_wall:.3f} | "
+              f"{per_cpu:.3f} |", flush=True)
+    return {"speed": rows}
+
+
+def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.device,
+                   out_dir: Path, minutes: float, stop_at_target: bool) -> dict:
+    """Train one scene, measuring every ``config.eval_every`` steps; the checks and targets."""
+    from metrics.errors import building_errors
+    from neural3d.extract import measure_field
+
+    truth = read_scene(scene_dir).building
+    checks: list[dict] = []
+    start, measuring = time.perf_counter(), 0.0
+
+    def check(step: int, field: TrainedField) -> bool:
+        nonlocal measuring
+        tic = time.perf_counter()
+        result, _ = measure_field(field, extract, device=device)
+        errors = building_errors(result, truth)
+        row = {"step": step, "wall_s": tic - start - measuring,
+               "wwr_ape": errors.wwr_ape, "footprint_iou": errors.footprint_iou}
+        measuring += time.perf_counter() - tic
+        checks.append(row)
+        print(f"  {scene_dir.name} step {step}: {row}", flush=True)
+        return stop_at_target and _on_target(row)
+
+    train(scene_dir, config, out_dir, device=device, max_seconds=60.0 * minutes, callback=check)
+    return {"scene": scene_dir.name, "family": truth.type if truth else None, "checks": checks,
+            "target_reached": next((c for c in checks if _on_target(c)), None),
+            "final": checks[-1] if checks else None}
+
+
+def _on_target(row: dict) -> bool:
+    return (row["wwr_ape"] is not None and row["wwr_ape"] <= WWR_TARGET_PCT
+            and row["footprint_iou"] is not None and row["footprint_iou"] >= IOU_TARGET)
+
+
+def converge(args: argparse.Namespace) -> dict:
+    from neural3d.extract import ExtractConfig
+
+    device = resolve_device(args.device)
+    config = replace(preset_config("fast"), eval_every=args.check_every,
+                     checkpoint_every=args.check_every)
+    extract = ExtractConfig(resolution=args.resolution)
+    scenes = sorted(p for p in Path(args.benchmark).iterdir() if (p / "transforms.json").is_file())
+    if not scenes:
+        raise ValueError(f"{args.benchmark} holds no scene folder (transforms.json)")
+    out_dir = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="bench_neural3d_"))
+    results = []
+    for scene_dir in scenes:
+        r = converge_scene(scene_dir, config, extract, device, out_dir, args.minutes,
+                           args.stop_at_target)
+        results.append(r)
+        reached, final = r["target_reached"], r["final"] or {}
+        minutes = f"{reached['wall_s'] / 60:.1f}" if reached else "not reached"
+        print(f"| {r['scene']} | {minutes} | {final.get('step')} | {final.get('wwr_ape')} | "
+              f"{final.get('footprint_iou')} |", flush=True)
+    return {"converge": results, "device": str(device), "config": "fast"}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    sp = sub.add_parser("speed", help="training iterations per second per backbone")
+    sp.add_argument("--scene", type=Path, required=True, help="a scene folder")
+    sp.add_argument("--steps", type=int, default=5)
+    cv = sub.add_parser("converge", help="time until the targets on a benchmark folder")
+    cv.add_argument("--benchmark", type=Path, required=True, help="folder of scene folders")
+    cv.add_argument("--minutes", type=float, default=30.0, help="training limit per building")
+    cv.add_argument("--check-every", type=int, default=100, help="iterations between checks")
+    cv.add_argument("--resolution", type=int, default=128, help="marching-cubes resolution")
+    cv.add_argument("--stop-at-target", action="store_true",
+                    help="stop a building's training once both targets are met")
+    cv.add_argument("--out", type=Path, default=None, help="run folders (default: a temp dir)")
+    for p in (sp, cv):
+        p.add_argument("--device", default="cpu")
+        p.add_argument("--json", type=Path, default=None, help="also write the figures here")
+    args = parser.parse_args(argv)
+    try:
+        print(f"torch threads: {torch.get_num_threads()}", flush=True)
+        if args.command == "speed":
+            print("| case | device | rays | samples | it/s (wall) | it/s (CPU) |\n"
+                  "|---|---|---|---|---|---|")
+            figures = speed(args)
+        else:
+            print("| scene | minutes to target | final step | WWR APE % | footprint IoU |\n"
+                  "|---|---|---|---|---|")
+            figures = converge(args)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if args.json:
+        write_json_atomic(args.json, figures)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
