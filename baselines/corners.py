@@ -2,7 +2,8 @@
 
 Algorithm (all in continuous image coordinates, pixel centres at +0.5):
 
-1. Outer contour of the mask (OpenCV, every boundary pixel) and its convex hull.
+1. Outer contours of the mask (OpenCV, every boundary pixel, all pieces) and
+   their convex hull.
 2. Minimum-area enclosing quadrilateral, greedily: while the hull has more than
    four edges, remove the edge whose removal (extending its two neighbours to
    their intersection) adds the least area. The result encloses the hull.
@@ -47,7 +48,9 @@ def enclosing_quadrilateral(mask: np.ndarray) -> np.ndarray:
 
 
 def outer_contour_uv(mask: np.ndarray) -> np.ndarray:
-    """(N, 2) float64 centres (u, v) of the boundary pixels of the mask's largest outer contour.
+    """(N, 2) float64 centres (u, v) of the boundary pixels of the mask's outer contours.
+
+    All pieces count: a facade cut into strips by occluders is still one facade.
 
     Raises
     ------
@@ -62,7 +65,7 @@ def outer_contour_uv(mask: np.ndarray) -> np.ndarray:
     )
     if not contours:
         raise ViewError("the facade mask is empty")
-    return max(contours, key=len).reshape(-1, 2).astype(np.float64) + 0.5
+    return np.concatenate([c.reshape(-1, 2) for c in contours]).astype(np.float64) + 0.5
 
 
 def minimum_area_quadrilateral(hull: np.ndarray) -> np.ndarray:

@@ -2,6 +2,10 @@
 
 facade = wall | window | door pixels (DESIGN.md). A natural view often shows a
 neighbouring facade too, joined to the target along the building corner.
+Occluders in front of a facade (class "other": balconies, railings) must not
+split it: connectivity is taken over facade | other pixels, and the result
+keeps the facade pixels of the component (a row of balconies across the whole
+facade would otherwise cut it into strips).
 
 * 2D-S sees only the mask, as the original method does: it keeps the
   8-connected facade component at the image centre (the photographer aimed at
@@ -75,11 +79,12 @@ def facade_class_mask(labels: np.ndarray) -> np.ndarray:
         labels, [int(c) for c in FACADE_CLASSES])
 
 
-def centre_component(mask: np.ndarray) -> np.ndarray:
-    """(H, W) bool: the 8-connected component of ``mask`` at the image centre.
+def centre_component(mask: np.ndarray, bridge: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) bool: the pixels of ``mask`` in its 8-connected component at the image centre.
 
-    When the centre pixel is not in the mask, the component of the mask pixel
-    nearest to the centre is taken.
+    Components are taken over ``mask | bridge`` (pixels that connect the mask
+    without belonging to it, e.g. occluders). When the centre pixel is in
+    neither, the component of the mask pixel nearest to the centre is taken.
 
     Raises
     ------
@@ -89,7 +94,8 @@ def centre_component(mask: np.ndarray) -> np.ndarray:
     mask = np.asarray(mask, dtype=bool)
     if not mask.any():
         raise ViewError("no facade pixels (wall, window or door) in the semantic mask")
-    n, comp = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8)
+    joined = mask if bridge is None else mask | np.asarray(bridge, dtype=bool)
+    _, comp = cv2.connectedComponents(joined.astype(np.uint8), connectivity=8)
     h, w = mask.shape
     cy, cx = h // 2, w // 2
     label = comp[cy, cx]
@@ -97,12 +103,17 @@ def centre_component(mask: np.ndarray) -> np.ndarray:
         ys, xs = np.nonzero(mask)
         i = int(np.argmin((ys - cy) ** 2 + (xs - cx) ** 2))
         label = comp[ys[i], xs[i]]
-    return comp == label
+    return (comp == label) & mask
+
+
+def occluder_mask(labels: np.ndarray) -> np.ndarray:
+    """(H, W) bool: pixels of class "other" (balconies, railings), which may hide a facade."""
+    return np.asarray(labels) == SemanticClass.OTHER
 
 
 def isolate_facade_2ds(labels: np.ndarray) -> np.ndarray:
     """(H, W) bool mask of the target facade as 2D-S sees it (centre component)."""
-    return centre_component(facade_class_mask(labels))
+    return centre_component(facade_class_mask(labels), occluder_mask(labels))
 
 
 def isolate_facade_on_plane(
@@ -165,7 +176,7 @@ def isolate_facade_on_plane(
     keep = facade & (depth > 0) & (dist <= tol) & (dist >= lowest)
     if not keep.any():
         raise ViewError("no facade pixel lies on the fitted facade plane")
-    return centre_component(keep), plane
+    return centre_component(keep, occluder_mask(labels)), plane
 
 
 def _fit_pixels(facade: np.ndarray, depth: np.ndarray, stride: int) -> tuple[np.ndarray, ...]:

@@ -3,7 +3,8 @@
 The facade is the plane y = 0, x in [0, L], z in [0, H], facing -y (the
 building is at y > 0). Windows are axis-aligned rectangles (x0, z0, x1, z1) in
 it; their glass may be recessed by ``recess_m`` (the reveal reads as window).
-With ``gable_m`` > 0 a triangular gable of that height tops the facade.
+With ``gable_m`` > 0 a triangular gable of that height tops the facade;
+``balconies`` (z0, z1) are full-width class-"other" panels 1.2 m in front of it.
 An optional neighbour facade at x = L, y in [0, neighbour_m], faces +x, and the
 ground z = 0 is background with depth. Every image comes from ray-plane
 intersections through pixel centres (dataset.camera.rays_world), so it is exact.
@@ -20,6 +21,7 @@ from dataset.classes import SemanticClass
 from dataset.images import write_depth_m, write_labels, write_rgb
 from dataset.scene import Frame, Scene, write_transforms
 
+BALCONY_M = 1.2  # balcony panels stand this far in front of the facade
 GROUND_RANGE_M = 50.0  # the ground ends here, so that depth fits a 16-bit PNG in mm
 
 
@@ -43,7 +45,8 @@ def true_wwr(length_m, height_m, windows, gable_m: float = 0.0) -> float:
 
 def render_facade(intrinsics: Intrinsics, world_from_camera: np.ndarray, *, length_m: float,
                   height_m: float, windows, recess_m: float = 0.0,
-                  neighbour_m: float = 0.0, gable_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+                  neighbour_m: float = 0.0, gable_m: float = 0.0,
+                  balconies=()) -> tuple[np.ndarray, np.ndarray]:
     """(H, W) uint8 labels and (H, W) float64 z-depth (m, 0 = none) of the facade scene."""
     o, d = rays_world(intrinsics, world_from_camera)
     hw = d.shape[:2]
@@ -81,6 +84,14 @@ def render_facade(intrinsics: Intrinsics, world_from_camera: np.ndarray, *, leng
             hit = on & (t < depth)
             depth[hit] = t[hit]
             labels[hit] = SemanticClass.WALL
+        for z0, z1 in balconies:  # class "other" panels 1.2 m in front, full facade width
+            t = (-BALCONY_M - o[..., 1]) / d[..., 1]
+            p = o + t[..., None] * d
+            on = (t > 0) & (p[..., 0] >= 0) & (p[..., 0] <= length_m) & (p[..., 2] >= z0) & (
+                p[..., 2] <= z1)
+            hit = on & (t < depth)
+            depth[hit] = t[hit]
+            labels[hit] = SemanticClass.OTHER
     depth[~np.isfinite(depth)] = 0.0
     return labels, depth
 

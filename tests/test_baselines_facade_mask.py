@@ -98,3 +98,15 @@ def test_plane_isolation_prefers_the_facade_at_the_centre_over_a_bigger_neighbou
     _, free = isolate_facade_on_plane(labels, depth, K, PlaneIsolationConfig(
         anchor_points=10**6), np.random.default_rng(0))
     assert not np.allclose(free.normal, target_normal, atol=1e-3)
+
+
+def test_occluders_bridge_the_2ds_component():
+    labels = np.zeros((30, 20), np.uint8)
+    labels[2:10] = 1  # wall strip above ...
+    labels[10:14] = 5  # ... a balcony band (other) ...
+    labels[14:28] = 1  # ... and the wall strip around the image centre
+    labels[5:7, 5:8] = 2  # a window in the top strip
+    mask = isolate_facade_2ds(labels)
+    assert mask.sum() == 8 * 20 + 14 * 20 and not mask[10:14].any()
+    labels[10:14] = 0  # background instead: the strips are separate facades
+    assert isolate_facade_2ds(labels).sum() == 14 * 20

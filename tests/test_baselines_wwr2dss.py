@@ -156,3 +156,15 @@ def test_gable_facade_gets_its_upright_bounding_rectangle():
     assert g.length_m == pytest.approx(10.0, rel=L_TOL)
     assert g.height_m == pytest.approx(9.0, rel=L_TOL)
     assert wwr == pytest.approx(true_wwr(10.0, 6.0, wins, gable_m=3.0), abs=WWR_TOL)
+
+
+def test_balcony_bands_across_the_facade_do_not_cut_it_into_strips():
+    # Full-width balcony panels (class other) at every floor split the visible
+    # facade into strips; the whole facade is still measured.
+    balconies = [(2.2, 3.2), (5.2, 6.2)]
+    pose = facade_pose(L_M, H_M, distance_m=15.0, azimuth_deg=10.0)
+    labels, depth = render_facade(K, pose, length_m=L_M, height_m=H_M, windows=WINDOWS,
+                                  balconies=balconies)
+    g, _, _ = _measure(labels, depth, pose, K)
+    assert g.length_m == pytest.approx(L_M, rel=L_TOL)
+    assert g.height_m == pytest.approx(H_M, rel=L_TOL)
