@@ -319,6 +319,15 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _check_device(device: str) -> None:
     if device not in ("cpu", "cuda") and not device.startswith("cuda:"):
         raise ValueError(f"unknown device {device!r}; use cpu or cuda")
+    if device.startswith("cuda"):
+        import torch
+
+        if not torch.cuda.is_available():
+            raise ValueError(f"device {device} asked for, but torch sees no CUDA GPU; use cpu")
+        index = int(device.split(":")[1]) if ":" in device else 0
+        if index >= torch.cuda.device_count():
+            raise ValueError(f"device {device} asked for, but torch sees only "
+                             f"{torch.cuda.device_count()} CUDA GPU(s)")
 
 
 if __name__ == "__main__":

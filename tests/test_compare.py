@@ -123,6 +123,7 @@ def test_per_facade_rows(compared):
      (["--methods", "2D-S,magic"], "unknown method 'magic'"),
      (["--views", "sideways"], "unknown views 'sideways'"),
      (["--device", "tpu"], "unknown device 'tpu'"),
+     (["--device", "cuda:99"], "torch sees"),
      (["--neural3d-minutes", "0"], "neural3d minutes must be > 0")],
 )
 def test_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys, args, message):
