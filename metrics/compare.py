@@ -12,6 +12,7 @@ estimated footprints, the 2D-SS pipeline images of one facade and
 from __future__ import annotations
 
 import argparse
+import re
 import shutil
 import sys
 import time
@@ -317,8 +318,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _check_device(device: str) -> None:
-    if device not in ("cpu", "cuda") and not device.startswith("cuda:"):
-        raise ValueError(f"unknown device {device!r}; use cpu or cuda")
+    if device not in ("cpu", "cuda") and not re.fullmatch(r"cuda:\d+", device):
+        raise ValueError(f"unknown device {device!r}; use cpu, cuda or cuda:N")
     if device.startswith("cuda"):
         import torch
 
