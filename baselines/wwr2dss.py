@@ -261,15 +261,33 @@ def main(argv: list[str] | None = None) -> int:
                              "area = L*H")
     parser.add_argument("--combine", choices=COMBINES, default=Wwr2dssConfig.combine,
                         help="how the views of one facade are combined (default: mean)")
-    parser.add_argument("--device", default="cpu", help="torch device for the warps")
+    parser.add_argument("--device", default="cpu", help="torch device for the warps (cpu, cuda)")
+    parser.add_argument("--threads", type=int, default=None,
+                        help="torch CPU threads (default: torch's choice; 1 is faster on a "
+                             "machine busy with other jobs)")
     args = parser.parse_args(argv)
 
     def body() -> int:
+        device = _checked_device(args.device)
+        if args.threads is not None:
+            if args.threads < 1:
+                raise ValueError(f"--threads must be >= 1, got {args.threads}")
+            torch.set_num_threads(args.threads)
         config = Wwr2dssConfig(weighting=args.weighting, combine=args.combine)
         return run_scenes(args.data, args.out, lambda s: run_2dss(
-            s, args.views, config, debug_dir=args.debug_images, device=args.device))
+            s, args.views, config, debug_dir=args.debug_images, device=device))
 
     return main_guarded(parser.prog, body)
+
+
+def _checked_device(name: str) -> torch.device:
+    try:
+        device = torch.device(name)
+    except RuntimeError as exc:
+        raise ValueError(f"--device {name!r} is not a torch device: {exc}") from exc
+    if device.type == "cuda" and not torch.cuda.is_available():
+        raise ValueError(f"--device {name}: CUDA is not available here; use --device cpu")
+    return device
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+import torch
 from baselines_synthetic import (
     facade_pose,
     render_facade,
@@ -168,3 +169,12 @@ def test_balcony_bands_across_the_facade_do_not_cut_it_into_strips():
     g, _, _ = _measure(labels, depth, pose, K)
     assert g.length_m == pytest.approx(L_M, rel=L_TOL)
     assert g.height_m == pytest.approx(H_M, rel=L_TOL)
+
+
+def test_cli_refuses_a_device_it_cannot_use(tmp_path, capsys):
+    argv = ["--views", "ideal", "--data", str(tmp_path), "--device", "warp-drive"]
+    assert main(argv) == 2
+    assert "is not a torch device" in capsys.readouterr().err
+    if not torch.cuda.is_available():
+        assert main(["--views", "ideal", "--data", str(tmp_path), "--device", "cuda"]) == 2
+        assert "CUDA is not available" in capsys.readouterr().err
