@@ -132,9 +132,13 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
     k = view.intrinsics
     mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, config.isolation, rng)
     corners = enclosing_quadrilateral(mask)
-    corners_m = corners_camera_m(corners, plane, k)
+    try:
+        corners_m = corners_camera_m(corners, plane, k)
+        angle_error = np.max(np.abs(corner_angles_deg(corners_m) - 90.0))
+    except ViewError:  # a corner of a skewed quadrilateral beyond the plane's horizon
+        angle_error = np.inf
     source = "quadrilateral"
-    if np.max(np.abs(corner_angles_deg(corners_m) - 90.0)) > config.max_corner_angle_error_deg:
+    if angle_error > config.max_corner_angle_error_deg:
         up_camera = view.frame.world_from_camera[:3, :3].T @ np.array([0.0, 0.0, 1.0])
         corners_m = upright_rectangle_m(outer_contour_uv(mask), plane, k, up_camera)
         corners = image_from_camera_uv(corners_m, k)
