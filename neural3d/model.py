@@ -65,7 +65,7 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
     dirs_s = d[:, None, :].expand(n_rays, n_samples, 3).reshape(-1, 3)
     sdf, feature, grad = field.sdf_feature_gradient(pts, create_graph=training)
     rgb = field.colour(pts, dirs_s, grad, feature).reshape(n_rays, n_samples, 3)
-    logits = field.semantic_logits(feature).reshape(n_rays, n_samples, -1)
+    logits = field.semantic_logits(feature).reshape(n_rays, n_samples, field.num_classes)
     cos = (grad * dirs_s).sum(-1).reshape(n_rays, n_samples)
     alpha = neus_alpha(sdf.reshape(n_rays, n_samples), cos, lengths, field.inv_s(),
                        cos_anneal_ratio=cos_anneal_ratio(config, step))

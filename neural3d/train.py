@@ -150,6 +150,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
                        **parts, "psnr": psnr(out.rgb.detach(), pixels.rgb[idx]),
                        "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0]}
                 log_rows.append(row)
+                _write_log(run_dir, log_rows)
                 bar.set_postfix(loss=f"{row['loss']:.4f}", psnr=f"{row['psnr']:.2f}")
             stop = max_seconds is not None and train_s >= max_seconds
             if step % config.checkpoint_every == 0:
