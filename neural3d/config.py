@@ -55,13 +55,13 @@ class TrainConfig:
     """Everything one training run depends on; ``config.json`` of a run is this, as JSON."""
 
     model: FieldConfig = FieldConfig()
-    iterations: int = 3000
-    rays_per_batch: int = 1024
+    iterations: int = 2000
+    rays_per_batch: int = 512
     lr: float = 5e-3
     lr_final_factor: float = 0.05  # cosine decay ends at lr * this
     warmup: int = 100
-    samples_uniform: int = 32
-    samples_importance: int = 32
+    samples_uniform: int = 24
+    samples_importance: int = 24
     upsample_steps: int = 2
     cos_anneal_steps: int = 0  # NeuS cos-anneal length; 0 = no annealing
     rgb_weight: float = 1.0

@@ -38,6 +38,9 @@ class GeometricMLP(nn.Module):
                  radius: float, skip: int | None, normalise_weights: bool) -> None:
         super().__init__()
         d_in = 3 + extra_dim
+        if skip is not None and not (0 < skip <= layers and hidden > d_in):
+            raise ValueError(f"skip connection at layer {skip} needs 0 < skip <= {layers} layers "
+                             f"and hidden width > input width {d_in}, got hidden {hidden}")
         dims = [d_in] + [hidden] * layers + [out_dim]
         self.skip = skip
         self.d_in = d_in

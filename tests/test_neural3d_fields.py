@@ -70,3 +70,8 @@ def test_heads_shapes_and_ranges():
 def test_bad_class_count():
     with pytest.raises(ValueError, match="at least 2"):
         SemanticSDF(FieldConfig(), 1, *BOX)
+
+
+def test_skip_needs_a_wider_hidden_layer():
+    with pytest.raises(ValueError, match="skip connection"):
+        SemanticSDF(FieldConfig(backbone="mlp", mlp_hidden=32, mlp_skip=2), 6, *BOX)

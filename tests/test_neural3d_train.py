@@ -136,3 +136,13 @@ def test_cli_reports_errors_in_one_line(tmp_path, capsys):
     if not torch.cuda.is_available():
         assert main(["--scene", str(tmp_path), "--device", "cuda"]) == 2
         assert "CUDA is not available" in capsys.readouterr().err
+
+
+def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
+    tiny = preset_config("tiny")
+    model = replace(tiny.model, backbone="mlp", mlp_hidden=64, mlp_layers=4, mlp_skip=2,
+                    normals="finite_difference")
+    config = replace(tiny, model=model, iterations=3, rays_per_batch=16, eval_every=3)
+    run = train(scene, config, tmp_path, device=CPU)
+    field = load_trained_field(run, device=CPU)
+    assert torch.isfinite(field.sdf_m(torch.zeros(4, 3))).all()
