@@ -151,6 +151,12 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
             "labelled mesh. Finished scenes are skipped on a rerun, so an interrupted run "
             "resumes where it stopped."
         ),
+        epilog=(
+            "examples: python -m dataset.generate --preset tiny --out data/tiny | "
+            "python -m dataset.generate --preset paper --out data/paper --workers 2 | "
+            "python -m dataset.generate --mesh house.ply --out data/mine. "
+            "Layout and options: docs/rendering.md."
+        ),
     )
     src = p.add_mutually_exclusive_group(required=True)
     src.add_argument("--preset", choices=PRESETS, help="built-in set of procedural buildings")
