@@ -22,6 +22,7 @@ class DefaultBenchmark:
     views: int = 40
     workers: int = 2
     neural3d_resolution: int = 128
+    neural3d_eval_frames: int = 1
     expected_minutes: float = 10.0
 
     @property

@@ -289,8 +289,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         _check_device(args.device)
         default = DefaultBenchmark() if args.data is None else None
         resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
-        budget = Neural3dBudget(args.neural3d_preset, args.neural3d_minutes, resolution,
-                                args.device)
+        budget = Neural3dBudget(
+            preset=args.neural3d_preset, minutes=args.neural3d_minutes, resolution=resolution,
+            eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
+        )
         if default is not None:
             print(default.announce(methods, budget.minutes), flush=True)
         data = (ensure_benchmark(default) if default is not None else args.data).resolve()

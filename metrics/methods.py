@@ -26,11 +26,13 @@ NEURAL3D_EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geoj
 @dataclass(frozen=True)
 class Neural3dBudget:
     """How neural3d runs inside a comparison: training preset and time limit per building,
-    marching-cubes resolution of the extraction (``None``: neural3d's default), device."""
+    eval frames rendered at the end of training and marching-cubes resolution of the
+    extraction (``None``: the preset's / neural3d's own), device."""
 
     preset: Literal["paper", "fast", "tiny"] = "fast"
     minutes: float = 2.0
     resolution: int | None = None
+    eval_frames: int | None = None
     device: str = "cpu"
 
     def __post_init__(self) -> None:
@@ -38,6 +40,8 @@ class Neural3dBudget:
             raise ValueError(f"neural3d minutes must be > 0, got {self.minutes}")
         if self.resolution is not None and self.resolution < 8:
             raise ValueError(f"neural3d resolution must be >= 8, got {self.resolution}")
+        if self.eval_frames is not None and self.eval_frames < 1:
+            raise ValueError(f"neural3d eval frames must be >= 1, got {self.eval_frames}")
 
 
 def method_specs(
@@ -109,6 +113,9 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
     from neural3d.config import config_to_dict, preset_config
 
     train_config = preset_config(budget.preset)
+    if budget.eval_frames is not None:
+        # Rendering the eval frames costs about as much as a minute of CPU training.
+        train_config = replace(train_config, eval_max_frames=budget.eval_frames)
     extra = {
         "budget": {"preset": budget.preset, "max_seconds": budget.minutes * 60.0},
         "train": config_to_dict(train_config),

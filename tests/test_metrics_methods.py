@@ -15,13 +15,14 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     from neural3d.config import preset_config
 
     specs = method_specs(("2D-S", "2D-SS", "neural3d"), ("ideal",), tmp_path,
-                         neural3d=Neural3dBudget(preset="tiny", minutes=1.5, resolution=96))
+                         neural3d=Neural3dBudget(preset="tiny", minutes=1.5, resolution=96,
+                                                 eval_frames=1))
     s2ds, s2dss, n3d = specs
     assert (s2ds.protocols, s2ds.config) == (("ideal",), asdict(Wwr2dsConfig()))
     assert s2dss.config == asdict(Wwr2dssConfig())
     assert n3d.protocols == ("train",) and n3d.has_footprint
     assert n3d.config["budget"] == {"preset": "tiny", "max_seconds": 90.0}
-    assert n3d.config["train"] == asdict(preset_config("tiny"))
+    assert n3d.config["train"] == {**asdict(preset_config("tiny")), "eval_max_frames": 1}
     assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
     (default,) = method_specs(("neural3d",), (), tmp_path)
     assert "resolution" not in default.config
@@ -51,6 +52,8 @@ def test_budget_must_be_positive():
         Neural3dBudget(minutes=0)
     with pytest.raises(ValueError, match="resolution must be >= 8"):
         Neural3dBudget(resolution=4)
+    with pytest.raises(ValueError, match="eval frames must be >= 1"):
+        Neural3dBudget(eval_frames=0)
 
 
 def test_default_benchmark_announces_what_it_does(tmp_path):
