@@ -21,13 +21,14 @@ def render_pixels(field: SemanticSDF, pixels: Pixels, box_min: torch.Tensor,
     was_training = field.training
     field.eval()
     try:
-        for start in range(0, len(pixels), _EVAL_CHUNK):
-            sl = slice(start, start + _EVAL_CHUNK)
-            out = render_rays(field, pixels.origins[sl], pixels.dirs[sl], box_min, box_max,
-                              config, step=step, training=False,
-                              background_class=background_class)
-            rgb.append(out.rgb.detach())
-            sem.append(out.semantics.detach())
+        with torch.no_grad():  # normals still come from the SDF's gradient inside the field
+            for start in range(0, len(pixels), _EVAL_CHUNK):
+                sl = slice(start, start + _EVAL_CHUNK)
+                out = render_rays(field, pixels.origins[sl], pixels.dirs[sl], box_min, box_max,
+                                  config, step=step, training=False,
+                                  background_class=background_class)
+                rgb.append(out.rgb)
+                sem.append(out.semantics)
     finally:
         field.train(was_training)
     return torch.cat(rgb), torch.cat(sem)
