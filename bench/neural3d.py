@@ -19,6 +19,7 @@ reports the training time until WWR error <= 5 % and footprint IoU >= 0.96
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import tempfile
 import time
@@ -139,10 +140,11 @@ def converge(args: argparse.Namespace) -> dict:
     from neural3d.extract import ExtractConfig
 
     device = resolve_device(args.device)
-    config = replace(preset_config("fast"), eval_every=args.check_every,
-                     checkpoint_every=args.check_every)
+    config = replace(with_overrides(preset_config("fast"), args.set),
+                     eval_every=args.check_every, checkpoint_every=args.check_every)
     extract = ExtractConfig(resolution=args.resolution)
-    scenes = sorted(p for p in Path(args.benchmark).iterdir() if (p / "transforms.json").is_file())
+    scenes = sorted(p for p in Path(args.benchmark).iterdir() if (p / "transforms.json").is_file()
+                    and (args.scenes is None or p.name in args.scenes))
     if not scenes:
         raise ValueError(f"{args.benchmark} holds no scene folder (transforms.json)")
     out_dir = Path(args.out) if args.out else Path(tempfile.mkdtemp(prefix="bench_neural3d_"))
@@ -155,7 +157,29 @@ def converge(args: argparse.Namespace) -> dict:
         minutes = f"{reached['wall_s'] / 60:.1f}" if reached else "not reached"
         print(f"| {r['scene']} | {minutes} | {final.get('step')} | {final.get('wwr_ape')} | "
               f"{final.get('footprint_iou')} |", flush=True)
-    return {"converge": results, "device": str(device), "config": "fast"}
+    return {"converge": results, "device": str(device), "config": "fast",
+            "overrides": list(args.set)}
+
+
+def with_overrides(config: TrainConfig, settings: list[str]) -> TrainConfig:
+    """``config`` with ``key=value`` settings (``model.key`` for the field; JSON values)."""
+    train_kw, model_kw = {}, {}
+    for item in settings:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ValueError(f"--set expects key=value, got {item!r}")
+        try:
+            parsed = json.loads(value)
+        except json.JSONDecodeError:
+            parsed = value  # a bare string such as mlp
+        if key.startswith("model."):
+            model_kw[key[len("model."):]] = parsed
+        else:
+            train_kw[key] = parsed
+    try:
+        return replace(config, **train_kw, model=replace(config.model, **model_kw))
+    except TypeError as exc:
+        raise ValueError(f"bad --set: {exc}") from exc
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -172,6 +196,9 @@ def main(argv: list[str] | None = None) -> int:
     cv.add_argument("--stop-at-target", action="store_true",
                     help="stop a building's training once both targets are met")
     cv.add_argument("--out", type=Path, default=None, help="run folders (default: a temp dir)")
+    cv.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a fast-preset field, e.g. model.grid_coarse_to_fine_steps=300")
+    cv.add_argument("--scenes", nargs="*", default=None, help="only these scene names")
     for p in (sp, cv):
         p.add_argument("--device", default="cpu")
         p.add_argument("--json", type=Path, default=None, help="also write the figures here")
