@@ -1,6 +1,6 @@
 """How well does the mesh measurement recover the truth when the field is perfect?
 
-    python bench/oracle_measure.py [--preset tiny] [--resolutions 128 256]
+    python -m bench.oracle_measure [--preset tiny] [--resolutions 128 256] [--facades]
 
 For each building of a preset the ground-truth mesh itself plays the trained
 field: the SDF is its exact signed distance (sign from ray-parity inside tests,
@@ -24,7 +24,8 @@ from shapely.geometry import shape
 
 from dataset.mesh import LabelledMesh, triangle_areas_m2
 from dataset.presets import build_building, preset_recipes
-from neural3d.facade_match import facades_by_truth
+from metrics.facade_match import match_facades
+from neural3d.extract import facade_estimates
 from neural3d.footprint import footprint_from_sdf
 from neural3d.measure import MeasureConfig, measure_semantic_mesh
 from neural3d.meshing import extract_mesh, label_vertices
@@ -73,17 +74,16 @@ class OracleField:
         return self.mesh.face_label[self.sample_face[idx]].astype(np.int64)
 
 
-def _print_facades(v, f, labels, m, building, config: MeasureConfig) -> None:
-    matched, unmatched = facades_by_truth(v, f, labels, m, building.mesh, config=config)
-    for t in building.truth.facades:
-        e = matched.get(t.id)
-        est = "missing" if e is None else (
+def _print_facades(m, building) -> None:
+    match = match_facades(facade_estimates(m), building.truth)
+    for t, e in zip(building.truth.facades, match.facades):
+        est = e.reason if e.missing else (
             f"WWR {e.wwr:.3f} ({e.wwr - t.wwr:+.3f}), {e.facade_area_m2:.1f} m², "
             f"{e.width_m:.2f} x {e.height_m:.2f} m")
         print(f"    facade {t.id}: truth WWR {t.wwr:.3f}, {t.facade_area_m2:.1f} m², "
               f"{t.width_m:.2f} x {t.height_m:.2f} m | {est}")
-    if unmatched:
-        print(f"    {len(unmatched)} mesh group(s) matched no truth facade")
+    for _, reason in match.left_out:
+        print(f"    {reason}")
 
 
 def main() -> int:
@@ -91,7 +91,7 @@ def main() -> int:
     parser.add_argument("--preset", default="tiny")
     parser.add_argument("--resolutions", type=int, nargs="+", default=[128, 256])
     parser.add_argument("--facades", action="store_true",
-                        help="also print per-facade WWR (truth ids via neural3d.facade_match)")
+                        help="also print per-facade WWR (truth ids via metrics.facade_match)")
     args = parser.parse_args()
     print(f"{'building':18} {'res':>4} {'voxel m':>7} {'count':>8} {'WWR':>7} {'truth':>7} "
           f"{'err':>7} {'window %':>9} {'facade %':>9} {'IoU':>6} {'s':>5}")
@@ -120,7 +120,7 @@ def main() -> int:
                       f"{100 * (m.facade_area_m2 / truth.facade_area_m2 - 1):>+9.1f} "
                       f"{iou:>6.4f} {seconds:>5.0f}", flush=True)
                 if args.facades:
-                    _print_facades(v, f, labels, m, building, MeasureConfig(count=count))
+                    _print_facades(m, building)
     return 0
 
 

@@ -20,7 +20,13 @@ RESULT_SCHEMA_VERSION = 1
 
 @dataclass(frozen=True)
 class FacadeEstimate:
-    """A method's figures for one facade; ``missing`` + ``reason`` when it had no usable view."""
+    """A method's figures for one facade; ``missing`` + ``reason`` when it had no usable view.
+
+    ``normal`` (outward unit vector) and ``centre_m`` (area-weighted centroid of
+    the facade's surface) are in the world frame, for methods whose ids are
+    their own (neural3d): evaluation matches such facades to the truth's by
+    them (:mod:`metrics.facade_match`). ``None`` where the method does not say.
+    """
 
     id: int
     wwr: float | None
@@ -31,6 +37,15 @@ class FacadeEstimate:
     views_used: int = 0
     missing: bool = False
     reason: str = ""
+    normal: tuple[float, float, float] | None = None
+    centre_m: tuple[float, float, float] | None = None
+
+    @staticmethod
+    def from_json_dict(d: dict[str, Any]) -> FacadeEstimate:
+        """From JSON, where vectors are lists; files without ``normal``/``centre_m`` load too."""
+        vectors = {k: tuple(float(x) for x in d[k]) for k in ("normal", "centre_m")
+                   if d.get(k) is not None}
+        return FacadeEstimate(**{**d, **vectors})
 
 
 @dataclass(frozen=True)
@@ -67,7 +82,7 @@ class MethodResult:
         return MethodResult(
             **{
                 **d,
-                "facades": tuple(FacadeEstimate(**f) for f in d.get("facades", ())),
+                "facades": tuple(FacadeEstimate.from_json_dict(f) for f in d.get("facades", ())),
                 "warnings": tuple(d.get("warnings", ())),
             }
         )

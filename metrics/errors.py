@@ -19,11 +19,12 @@ from shapely.ops import unary_union
 from dataset.footprint import geojson_to_polygon
 from dataset.results import MethodResult
 from dataset.truth import BuildingTruth
+from metrics.facade_match import has_facade_geometry, match_facades
 
 Status = Literal["ok", "failed"]
 NO_TRUTH_FAMILY = "unknown"  # family of a scene without building.json (a user's photos)
 FACADE_PROTOCOLS = ("ideal", "multi")  # protocols whose facade ids are the truth's ids
-UNMATCHED_FACADES_WARNING = "no truth mesh matched"  # neural3d's note when ids are its own
+LEFT_OUT_FACADE_ID = 0  # facade id of a row for an estimate that faces no truth facade
 
 
 def absolute_percentage_error(estimate: float, truth: float) -> float:
@@ -166,43 +167,50 @@ def building_errors(result: MethodResult, truth: BuildingTruth | None) -> Buildi
 
 
 def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[FacadeErrors, ...]:
-    """Per-facade errors of a result whose facade ids are the truth's ids.
+    """Per-facade errors of a result, one row per truth facade the result names.
 
-    They are for the ideal and multi protocols (each view carries its facade
-    id) and for a result whose config says ``match_truth_facades`` (neural3d
-    numbers its facades after the truth facade each faces) unless its warnings
-    say no truth was matched. Other results give no rows.
+    Under the ideal and multi protocols the result's facade ids are the truth's
+    (each view carries its facade id). Other results (neural3d) number their
+    own facades; when every estimate carries ``normal`` and ``centre_m`` they
+    are matched to the truth's facades by :func:`metrics.facade_match.match_facades`,
+    and each estimate that faces no truth facade gives a failed row with
+    facade id ``LEFT_OUT_FACADE_ID`` (0) and the reason. Otherwise: no rows.
     """
-    if truth is None or not facade_ids_are_truth_ids(result):
+    if truth is None:
+        return ()
+    base = (result.scene, truth.type, result.method, result.protocol)
+    if result.protocol in FACADE_PROTOCOLS:
+        estimates, left_out = result.facades, ()
+    elif has_facade_geometry(result.facades):
+        try:
+            match = match_facades(result.facades, truth)
+        except ValueError as exc:  # a malformed result file fails its facades, not the run
+            return (FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=str(exc)),)
+        estimates, left_out = match.facades, match.left_out
+    else:
         return ()
     true_by_id = {f.id: f for f in truth.facades}
     rows = []
-    for est in result.facades:
+    for est in estimates:
         true = true_by_id.get(est.id)
-        base = (result.scene, truth.type, result.method, result.protocol, est.id)
         if true is None:
-            rows.append(FacadeErrors(*base, status="failed", reason="no such facade in the truth"))
+            rows.append(FacadeErrors(*base, est.id, status="failed",
+                                     reason="no such facade in the truth"))
         elif est.missing or est.wwr is None:
-            rows.append(FacadeErrors(*base, status="failed", reason=est.reason or "missing"))
+            rows.append(FacadeErrors(*base, est.id, status="failed",
+                                     reason=est.reason or "missing"))
         else:
             notes: list[str] = []
             wwr_ape = _ape_or_none(est.wwr, true.wwr, notes, "WWR")
             window_ape = _ape_or_none(est.window_area_m2, true.window_area_m2, notes, "window")
             facade_ape = _ape_or_none(est.facade_area_m2, true.facade_area_m2, notes, "facade")
             rows.append(FacadeErrors(
-                *base, reason="; ".join(notes), wwr_est=est.wwr, wwr_true=true.wwr,
+                *base, est.id, reason="; ".join(notes), wwr_est=est.wwr, wwr_true=true.wwr,
                 wwr_ape=wwr_ape, window_ape=window_ape, facade_ape=facade_ape,
             ))
+    rows.extend(FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=reason)
+                for _, reason in left_out)
     return tuple(rows)
-
-
-def facade_ids_are_truth_ids(result: MethodResult) -> bool:
-    """Whether the result's facade ids are the truth's (see :func:`facade_errors`)."""
-    if result.protocol in FACADE_PROTOCOLS:
-        return True
-    return result.config.get("match_truth_facades") is True and not any(
-        UNMATCHED_FACADES_WARNING in w for w in result.warnings
-    )
 
 
 def _ape_or_none(

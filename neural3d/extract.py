@@ -9,9 +9,10 @@
 - ``footprint.geojson``: zero contour of the SDF at ``footprint_height_m``;
 - ``<scene>__neural3d__train.json``: the :class:`dataset.results.MethodResult`.
 
-Per-facade figures carry the ground truth's facade ids when the run's scene
-folder has ``mesh.ply`` (see :mod:`neural3d.facade_match`); otherwise the mesh's
-own group numbers from 1.
+Facades are the mesh's own facade groups (:mod:`neural3d.measure`), numbered
+1..K, each with its outward normal and centre in world metres; nothing of the
+ground truth is read. Evaluation pairs them with the truth's facades
+(:mod:`metrics.facade_match`).
 """
 
 from __future__ import annotations
@@ -28,12 +29,10 @@ import torch
 from dataset.atomic import write_json_atomic
 from dataset.classes import NUM_CLASSES, class_id_from_name
 from dataset.footprint import polygon_to_geojson
-from dataset.mesh import read_labelled_ply
 from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
 from neural3d.device import resolve_device
-from neural3d.facade_match import facades_by_truth
 from neural3d.footprint import footprint_from_sdf
-from neural3d.measure import MeasureConfig, MeshFacade, measure_semantic_mesh
+from neural3d.measure import MeasureConfig, MeshMeasurement, measure_semantic_mesh
 from neural3d.meshing import (
     ColorFn,
     LabelFn,
@@ -67,7 +66,6 @@ class ExtractConfig:
     footprint_height_m: float = 0.5
     footprint_cell_m: float | None = None
     footprint_min_area_m2: float = 1.0
-    match_truth_facades: bool = True
     measure: MeasureConfig = field(default_factory=MeasureConfig)
 
     def __post_init__(self) -> None:
@@ -168,7 +166,7 @@ def measure_field(
     warnings: list[str] = []
     if m.wwr is None:
         warnings.append("the mesh has no wall, window or door vertex: WWR undefined")
-    facades = _facade_estimates(trained, mesh, m, config, warnings)
+    facades = facade_estimates(m)
     try:
         polygon = footprint_from_sdf(
             field_sdf_fn(trained, device, config.chunk_points), trained.box_min_m,
@@ -227,30 +225,14 @@ def extract_run(
     return result
 
 
-def _facade_estimates(trained, mesh: SemanticMesh, m, config: ExtractConfig,
-                      warnings: list[str]) -> tuple[FacadeEstimate, ...]:
-    truth_mesh_path = Path(trained.scene_dir) / "mesh.ply"
-    if not (config.match_truth_facades and truth_mesh_path.is_file()):
-        warnings.append("facade ids are the mesh's own group numbers (no truth mesh matched)")
-        return tuple(_estimate(f, f.index + 1) for f in m.facades)
-    truth_mesh = read_labelled_ply(truth_mesh_path)
-    matched, unmatched = facades_by_truth(mesh.vertices_m, mesh.faces, mesh.vertex_labels, m,
-                                          truth_mesh, config=config.measure)
-    if unmatched:
-        warnings.append(f"{len(unmatched)} mesh facade group(s) face no truth facade; left out")
-    truth_ids = sorted(set(np.unique(truth_mesh.face_facade).tolist()) - {0})
+def facade_estimates(measurement: MeshMeasurement) -> tuple[FacadeEstimate, ...]:
+    """The mesh's facade groups as result entries: ids 1..K, figures, normal and centre."""
     return tuple(
-        _estimate(matched[i], i) if i in matched else
-        FacadeEstimate(id=i, wwr=None, missing=True,
-                       reason="no facade of the mesh lies on this facade")
-        for i in truth_ids
+        FacadeEstimate(id=f.index + 1, wwr=f.wwr, window_area_m2=f.window_area_m2,
+                       facade_area_m2=f.facade_area_m2, width_m=f.width_m,
+                       height_m=f.height_m, normal=f.normal, centre_m=f.centre_m)
+        for f in measurement.facades
     )
-
-
-def _estimate(f: MeshFacade, facade_id: int) -> FacadeEstimate:
-    return FacadeEstimate(id=int(facade_id), wwr=f.wwr, window_area_m2=f.window_area_m2,
-                          facade_area_m2=f.facade_area_m2, width_m=f.width_m,
-                          height_m=f.height_m)
 
 
 def _class_ids_of(class_names) -> np.ndarray:

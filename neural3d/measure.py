@@ -82,6 +82,8 @@ class MeshFacade:
     triangles and ``width_m`` the gross area over the height: exact for a
     rectangular facade, the arc length for a curved one, and, unlike an extent
     along the wall, blind to stray triangles whose normals join a neighbour.
+    ``centre_m`` is the centroid (world m) of its triangles weighted by their
+    facade-class area: where the facade is, for matching it to another's.
     """
 
     index: int
@@ -96,6 +98,7 @@ class MeshFacade:
     width_m: float
     height_m: float
     face_count: int
+    centre_m: tuple[float, float, float]
 
 
 @dataclass(frozen=True)
@@ -238,6 +241,7 @@ def _facade_figures(
         width_m=gross / height if height > 0 else 0.0,
         height_m=height,
         face_count=int(mask.sum()),
+        centre_m=tuple(float(c) for c in np.average(tri.mean(axis=1), axis=0, weights=weight)),
     )
 
 

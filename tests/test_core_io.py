@@ -1,5 +1,8 @@
 """Round trips of the shared core: camera projection, labelled PLY, images, transforms.json, WWR."""
 
+import json
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import trimesh
@@ -149,9 +152,25 @@ def test_result_file_round_trip(tmp_path):
     )
     path = write_result(tmp_path, r)
     assert read_result(path) == r
+    located = replace(r, facades=(FacadeEstimate(id=1, wwr=0.3, normal=(0.0, -1.0, 0.0),
+                                                 centre_m=(1.5, -2.0, 4.25)),))
+    assert read_result(write_result(tmp_path, located)) == located
     path.write_text("{not json")
     with pytest.raises(ValueError, match="not a valid result"):
         read_result(path)
+
+
+def test_result_file_without_facade_geometry_still_loads(tmp_path):
+    """Files written before FacadeEstimate had ``normal`` and ``centre_m``."""
+    old = {"scene": "s", "method": "2D-S", "protocol": "ideal", "wwr": 0.3,
+           "window_area_m2": None, "facade_area_m2": None,
+           "facades": [{"id": 1, "wwr": 0.3, "window_area_m2": None, "facade_area_m2": None,
+                        "width_m": None, "height_m": None, "views_used": 2,
+                        "missing": False, "reason": ""}]}
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(old))
+    facade = read_result(path).facades[0]
+    assert (facade.views_used, facade.normal, facade.centre_m) == (2, None, None)
 
 
 def test_footprint_geojson_round_trip():

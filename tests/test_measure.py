@@ -53,6 +53,9 @@ def test_box_with_window_band(banded_box):
         # the cut vertical edges (one voxel wide) go to one neighbour or the other
         assert facade.facade_area_m2 == pytest.approx(width * 10, abs=10 * 2 * 0.08)
     np.testing.assert_allclose([f.offset_m for f in m.facades], [3, 2, 3, 2], atol=0.05)
+    # centres: the middle of each side at half height (edge strips and voxels: 0.1 m)
+    np.testing.assert_allclose([f.centre_m for f in m.facades],
+                               [[3, 0, 5], [0, 2, 5], [-3, 0, 5], [0, -2, 5]], atol=0.1)
 
 
 def test_cylinder_curved_facade():

@@ -7,6 +7,7 @@ import pytest
 from metrics_helpers import make_result, make_truth
 from shapely.geometry import MultiPolygon, Point, Polygon, box
 
+from dataset.results import FacadeEstimate
 from metrics.errors import (
     absolute_percentage_error,
     building_errors,
@@ -127,12 +128,30 @@ def test_facade_errors_missing_unknown_and_unmatched_protocol():
     assert facade_errors(replace(result, protocol="train"), make_truth("a")) == ()
 
 
-def test_neural3d_facades_count_only_when_matched_to_the_truth():
-    result = make_result("a", "neural3d", "train", 0.25, facade_wwrs=(0.3, 0.25))
-    matched = replace(result, config={"match_truth_facades": True})
-    assert [r.wwr_ape for r in facade_errors(matched, make_truth("a"))] == pytest.approx(
-        [20.0, 0.0], abs=TOL)
-    unmatched = replace(matched, warnings=(
-        "facade ids are the mesh's own group numbers (no truth mesh matched)",))
-    assert facade_errors(unmatched, make_truth("a")) == ()
-    assert facade_errors(result, None) == ()
+def test_neural3d_facades_are_matched_to_the_truth_by_normal_and_centre():
+    """make_truth: facade 1 faces +x (40 m², WWR 0.25), facade 2 faces +y (20 m², WWR 0.25)."""
+    result = make_result("a", "neural3d", "train", 0.25)
+    own = (  # the method's ids: two halves of facade 1, one facing down, none on facade 2
+        FacadeEstimate(id=1, wwr=0.3, window_area_m2=6.0, facade_area_m2=20.0,
+                       normal=(1.0, 0.0, 0.0), centre_m=(10.0, 2.0, 2.0)),
+        FacadeEstimate(id=2, wwr=0.2, window_area_m2=4.0, facade_area_m2=20.0,
+                       normal=(0.9, 0.1, 0.0), centre_m=(10.0, 7.0, 2.0)),
+        FacadeEstimate(id=3, wwr=0.5, window_area_m2=1.0, facade_area_m2=2.0,
+                       normal=(0.0, 0.0, -1.0), centre_m=(5.0, 5.0, 0.0)),
+    )
+    rows = facade_errors(replace(result, facades=own), make_truth("a"))
+    assert [(r.facade_id, r.status) for r in rows] == [(1, "ok"), (2, "failed"), (0, "failed")]
+    assert rows[0].wwr_est == pytest.approx(10.0 / 40.0, abs=TOL)  # (6 + 4) / (20 + 20)
+    assert (rows[0].wwr_ape, rows[0].window_ape, rows[0].facade_ape) == pytest.approx(
+        (0.0, 0.0, 0.0), abs=TOL)
+    assert rows[1].reason == "no estimated facade lies on this facade"
+    assert "estimated facade 3 faces no truth facade" in rows[2].reason
+    # without normal and centre the method's own ids mean nothing to the truth: no rows
+    assert facade_errors(replace(result, facades=own[:2] + (replace(own[2], normal=None),)),
+                         make_truth("a")) == ()
+    assert facade_errors(make_result("a", "neural3d", "train", 0.25, facade_wwrs=(0.3, 0.25)),
+                         make_truth("a")) == ()
+    assert facade_errors(replace(result, facades=own), None) == ()
+    bad = replace(result, facades=(replace(own[0], normal=(0.0, 0.0, 0.0)),))
+    (row,) = facade_errors(bad, make_truth("a"))
+    assert row.status == "failed" and "zero normal" in row.reason
