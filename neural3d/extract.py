@@ -54,8 +54,9 @@ class ExtractConfig:
 
     ``resolution`` is the number of marching-cubes samples along the scene box's
     longest side. The footprint plane sits ``footprint_height_m`` above the
-    ground (z = 0): above the ground's reconstruction noise, below sills and
-    overhangs; its grid spacing ``footprint_cell_m`` is, when None, half the
+    ground (z = 0): above the least constrained band of a trained field (no
+    camera sees the base from below and the scene box is cut at z = 0), below
+    balconies and overhangs; its grid spacing ``footprint_cell_m`` is, when None, half the
     mesh's voxel, so the footprint is as fine as the mesh and costs
     (2 x resolution)² field queries.
     """
@@ -63,7 +64,7 @@ class ExtractConfig:
     resolution: int = 256
     chunk_points: int = 1 << 16
     min_component_area_fraction: float = 0.01  # floaters of a neural SDF
-    footprint_height_m: float = 0.5
+    footprint_height_m: float = 1.0  # L-shape IoU 0.82 at 0.2 m, 0.93 at 0.5 m, 0.97 at 1 m
     footprint_cell_m: float | None = None
     footprint_min_area_m2: float = 1.0
     measure: MeasureConfig = field(default_factory=MeasureConfig)
