@@ -164,16 +164,7 @@ def read_labelled_ply(path: str | Path) -> LabelledMesh:
     ValueError
         If the file has no face ``label`` property or is not a triangle mesh.
     """
-    import trimesh
-
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"mesh file {path} does not exist")
-    try:
-        tm = trimesh.load(path, process=False, force="mesh")
-    except Exception as exc:  # trimesh raises many types on bad files
-        raise ValueError(f"cannot read {path} as a PLY mesh: {exc}") from exc
-    face_props = (tm.metadata.get("_ply_raw", {}).get("face", {}) or {}).get("data", None)
+    tm, face_props = read_ply_with_properties(path, "face")
     names = face_props.dtype.names if face_props is not None else ()
     if "label" not in (names or ()):
         raise ValueError(
@@ -187,3 +178,29 @@ def read_labelled_ply(path: str | Path) -> LabelledMesh:
         else np.full(len(label), NO_FACADE)
     )
     return LabelledMesh(np.asarray(tm.vertices), np.asarray(tm.faces), label, facade)
+
+
+def read_ply_with_properties(path: str | Path, element: str):
+    """A PLY as a ``trimesh.Trimesh`` and the raw per-``element`` properties ("vertex" or "face").
+
+    Returns
+    -------
+    mesh : trimesh.Trimesh (not processed, so order is kept)
+    properties : structured numpy array with one field per property, or ``None``
+
+    Raises
+    ------
+    ValueError
+        If the file is missing or trimesh cannot read it as a mesh.
+    """
+    import trimesh
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"mesh file {path} does not exist")
+    try:
+        tm = trimesh.load(path, process=False, force="mesh")
+    except Exception as exc:  # trimesh raises many types on bad files
+        raise ValueError(f"cannot read {path} as a PLY mesh: {exc}") from exc
+    raw = (tm.metadata.get("_ply_raw", {}).get(element, {}) or {}).get("data", None)
+    return tm, raw

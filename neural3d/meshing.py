@@ -21,7 +21,7 @@ from tqdm import tqdm
 
 from dataset.atomic import write_bytes_atomic
 from dataset.classes import NUM_CLASSES
-from dataset.mesh import triangle_areas_m2
+from dataset.mesh import read_ply_with_properties, triangle_areas_m2
 
 SdfFn = Callable[[np.ndarray], np.ndarray]
 LabelFn = Callable[[np.ndarray], np.ndarray]
@@ -320,16 +320,7 @@ def read_semantic_ply(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndar
     ValueError
         If the file is missing, unreadable or has no vertex ``label``.
     """
-    import trimesh
-
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"mesh file {path} does not exist")
-    try:
-        tm = trimesh.load(path, process=False, force="mesh")
-    except Exception as exc:  # trimesh raises many types on bad files
-        raise ValueError(f"cannot read {path} as a PLY mesh: {exc}") from exc
-    raw = (tm.metadata.get("_ply_raw", {}).get("vertex", {}) or {}).get("data", None)
+    tm, raw = read_ply_with_properties(path, "vertex")
     names = raw.dtype.names if raw is not None else None
     if "label" not in (names or ()):
         raise ValueError(f"{path} has no per-vertex 'label' property; write it with "
