@@ -116,9 +116,14 @@ class SDFNetwork(nn.Module):
         x = torch.randn(4096, 3, generator=gen)
         # On a shell around the radius: the zero level set is what must come out right.
         x = x / x.norm(dim=1, keepdim=True) * radius * (0.5 + torch.rand(4096, 1, generator=gen))
-        raw = self(x)[0]
-        design = torch.stack([raw, torch.ones_like(raw)], dim=1)
-        a, b = torch.linalg.lstsq(design, (x.norm(dim=1) - radius)[:, None]).solution[:, 0]
+        raw = self(x)[0].double()
+        target = x.norm(dim=1).double() - radius
+        # Closed-form simple linear regression rather than torch.linalg.lstsq: LAPACK's
+        # result depends on the memory alignment of its inputs, which made identical
+        # runs start from fields a few ulps apart (and so not bit-reproducible).
+        raw_c = raw - raw.mean()
+        a = float((raw_c * (target - target.mean())).sum() / (raw_c * raw_c).sum())
+        b = float(target.mean() - a * raw.mean())
         last = self.mlp.linears[-1]
         if hasattr(last, "parametrizations"):
             last.parametrizations.weight.original0[0] *= a
