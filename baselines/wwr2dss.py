@@ -53,6 +53,7 @@ from baselines.rectify import (
     rectify_labels,
 )
 from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
+from dataset.device import resolve_device
 from dataset.images import read_rgb
 from dataset.results import FacadeEstimate, MethodResult
 from dataset.scene import Scene
@@ -272,7 +273,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     def body() -> int:
-        device = _checked_device(args.device)
+        device = resolve_device(args.device)
         if args.threads is not None:
             if args.threads < 1:
                 raise ValueError(f"--threads must be >= 1, got {args.threads}")
@@ -282,16 +283,6 @@ def main(argv: list[str] | None = None) -> int:
             s, args.views, config, debug_dir=args.debug_images, device=device))
 
     return main_guarded(parser.prog, body)
-
-
-def _checked_device(name: str) -> torch.device:
-    try:
-        device = torch.device(name)
-    except RuntimeError as exc:
-        raise ValueError(f"--device {name!r} is not a torch device: {exc}") from exc
-    if device.type == "cuda" and not torch.cuda.is_available():
-        raise ValueError(f"--device {name}: CUDA is not available here; use --device cpu")
-    return device
 
 
 if __name__ == "__main__":

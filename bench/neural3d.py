@@ -32,6 +32,7 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 import torch  # noqa: E402
 
 from dataset.atomic import write_json_atomic  # noqa: E402
+from dataset.device import resolve_device  # noqa: E402
 from dataset.scene import read_scene  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
 from neural3d.data import (  # noqa: E402
@@ -40,7 +41,6 @@ from neural3d.data import (  # noqa: E402
     load_frames,
     scene_normalisation,
 )
-from neural3d.device import resolve_device  # noqa: E402
 from neural3d.losses import total_loss  # noqa: E402
 from neural3d.model import render_rays  # noqa: E402
 from neural3d.train import train  # noqa: E402

@@ -12,7 +12,6 @@ estimated footprints, the 2D-SS pipeline images of one facade and
 from __future__ import annotations
 
 import argparse
-import re
 import shutil
 import sys
 import time
@@ -22,6 +21,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
+from dataset.device import resolve_device
 from dataset.results import code_version
 from dataset.truth import BuildingTruth, read_building
 from metrics.aggregate import aggregate_by_family
@@ -286,7 +286,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         start = time.perf_counter()
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         views = tuple(v.strip() for v in args.views.split(",") if v.strip())
-        _check_device(args.device)
+        resolve_device(args.device)
         default = DefaultBenchmark() if args.data is None else None
         resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
         budget = Neural3dBudget(
@@ -317,20 +317,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
           f"(results in {results}); {time.perf_counter() - start:.0f} s")
     return 0
-
-
-def _check_device(device: str) -> None:
-    if device not in ("cpu", "cuda") and not re.fullmatch(r"cuda:\d+", device):
-        raise ValueError(f"unknown device {device!r}; use cpu, cuda or cuda:N")
-    if device.startswith("cuda"):
-        import torch
-
-        if not torch.cuda.is_available():
-            raise ValueError(f"device {device} asked for, but torch sees no CUDA GPU; use cpu")
-        index = int(device.split(":")[1]) if ":" in device else 0
-        if index >= torch.cuda.device_count():
-            raise ValueError(f"device {device} asked for, but torch sees only "
-                             f"{torch.cuda.device_count()} CUDA GPU(s)")
 
 
 if __name__ == "__main__":

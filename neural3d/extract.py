@@ -28,9 +28,9 @@ import torch
 
 from dataset.atomic import write_json_atomic
 from dataset.classes import NUM_CLASSES, class_id_from_name
+from dataset.device import resolve_device
 from dataset.footprint import polygon_to_geojson
 from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
-from neural3d.device import resolve_device
 from neural3d.footprint import footprint_from_sdf
 from neural3d.measure import MeasureConfig, MeshMeasurement, measure_semantic_mesh
 from neural3d.meshing import (

@@ -25,6 +25,7 @@ import torch
 from tqdm import tqdm
 
 from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.device import resolve_device
 from dataset.results import code_version
 from dataset.scene import read_scene
 from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
@@ -36,7 +37,6 @@ from neural3d.data import (
     scene_name,
     scene_normalisation,
 )
-from neural3d.device import resolve_device
 from neural3d.evaluate import evaluate
 from neural3d.losses import psnr, total_loss
 from neural3d.model import render_rays

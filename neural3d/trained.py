@@ -9,9 +9,9 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from dataset.device import resolve_device
 from neural3d.checkpoint import read_checkpoint
 from neural3d.config import FieldConfig, config_from_dict
-from neural3d.device import resolve_device
 from neural3d.fields import SemanticSDF
 from neural3d.normalisation import Normalisation
 

@@ -16,14 +16,15 @@ def resolve_device(device: str | torch.device) -> torch.device:
     try:
         dev = torch.device(device)
     except (RuntimeError, TypeError) as exc:
-        raise ValueError(f"unknown device {device!r}; use 'cpu' or 'cuda'") from exc
+        raise ValueError(f"unknown device {device!r}: it is not a torch device; use 'cpu' or 'cuda'"
+                         ) from exc
     if dev.type not in ("cpu", "cuda"):
         raise ValueError(f"unsupported device {device!r}; use 'cpu' or 'cuda'")
     if dev.type == "cuda":
         if not torch.cuda.is_available():
-            raise ValueError(f"device {device!r} asked for but CUDA is not available on this "
-                             "machine (or this torch build); use --device cpu")
+            raise ValueError(f"device {device!r} asked for, but CUDA is not available: torch "
+                             "sees no CUDA GPU on this machine (or this build); use cpu")
         if dev.index is not None and dev.index >= torch.cuda.device_count():
-            raise ValueError(f"device {device!r} does not exist: this machine has "
+            raise ValueError(f"device {device!r} does not exist: torch sees "
                              f"{torch.cuda.device_count()} CUDA device(s)")
     return dev
