@@ -112,7 +112,7 @@ def main() -> int:
             truth_fp = shape(truth.footprint)
             iou = poly.intersection(truth_fp).area / poly.union(truth_fp).area
             seconds = time.perf_counter() - start
-            for count in ("all", "grouped"):
+            for count in ("projected", "all", "grouped"):
                 m = measure_semantic_mesh(v, f, labels, config=MeasureConfig(count=count))
                 print(f"{recipe.id:18} {res:>4} {voxel:>7.3f} {count:>8} {m.wwr:>7.4f} "
                       f"{truth.wwr:>7.4f} {m.wwr - truth.wwr:>+7.4f} "

@@ -19,6 +19,26 @@ facade triangles' normals:
 4. groups smaller than ``min_facade_area_m2`` or ``min_facade_area_fraction`` of
    the grouped area (window-reveal strips, noise) are dropped.
 
+How areas are counted (``MeasureConfig.count``):
+
+- ``"projected"`` (default): the groups only propose facade planes (their mean
+  normal and offset). Planes are then taken greedily, the one with the most
+  projected facade area first; a plane claims every unclaimed facade triangle
+  within ``plane_slab_m`` of it that faces it within ``plane_max_angle_deg``,
+  and a triangle counts with its area projected onto the plane (area x n.N).
+  So the sloped sides of a rounded window recess, a wavy wall or a reveal
+  count once, as their shadow on the facade plane, as the truth's openings do;
+  a surface that faces up or down (the underside a neural field may close the
+  building with at the ground, the floor of a recess) counts for nothing.
+  A triangle that faces two planes at least ``plane_max_angle_deg`` apart (the
+  cut corner between two walls) counts on both; on a plane's own triangles the
+  shadow is divided by the cosine of their ``curve_strip_m`` wide strip, so a
+  curved wall keeps its true area. Facade triangles near no plane count with
+  their full area if they are within ``facade_max_tilt_deg`` of vertical (a
+  wall curving away from every plane), else not at all.
+- ``"all"`` sums the classes over every triangle (the paper);
+- ``"grouped"`` only over triangles in a kept group.
+
 A curved facade has no peaks of its own, so it is cut into segments about
 ``min_facade_separation_deg`` wide; the whole-building figures do not depend on
 the grouping.
@@ -41,12 +61,13 @@ from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
 class MeasureConfig:
     """How facade areas are counted and facades grouped (see the module docstring).
 
-    ``count="all"`` sums the classes over every triangle (the paper);
-    ``count="grouped"`` only over triangles in a kept facade group, which leaves
-    out window reveals and small pieces facing other ways.
+    ``count="projected"`` counts facade triangles by their shadow on the nearest
+    facade plane (robust to the wavy walls, recesses and undersides of a neural
+    field's mesh); ``count="all"`` sums the classes over every triangle (the
+    paper); ``count="grouped"`` only over triangles in a kept facade group.
     """
 
-    count: Literal["all", "grouped"] = "all"
+    count: Literal["projected", "all", "grouped"] = "projected"
     facade_max_tilt_deg: float = 30.0
     azimuth_bin_deg: float = 1.0
     azimuth_smoothing_deg: float = 3.0
@@ -54,10 +75,17 @@ class MeasureConfig:
     plane_gap_m: float = 1.0
     min_facade_area_m2: float = 1.0
     min_facade_area_fraction: float = 0.02
+    # a trained wall wanders ~0.2 m; 0.4 m keeps a 5 m radius curve's segments within 2 %
+    plane_slab_m: float = 0.4
+    plane_max_angle_deg: float = 60.0
+    curve_strip_m: float = 1.0  # wider than a window recess, narrow enough to follow a curve
 
     def __post_init__(self) -> None:
-        if self.count not in ("all", "grouped"):
-            raise ValueError(f"count must be 'all' or 'grouped', got {self.count!r}")
+        if self.count not in ("projected", "all", "grouped"):
+            raise ValueError(f"count must be 'projected', 'all' or 'grouped', got {self.count!r}")
+        if not 0.0 < self.plane_max_angle_deg < 90.0:
+            raise ValueError(f"plane_max_angle_deg must be in (0, 90), got "
+                             f"{self.plane_max_angle_deg}")
         if not 0.0 <= self.facade_max_tilt_deg < 90.0:
             raise ValueError(f"facade_max_tilt_deg must be in [0, 90), got "
                              f"{self.facade_max_tilt_deg}")
@@ -67,9 +95,11 @@ class MeasureConfig:
             raise ValueError("min_facade_separation_deg must be in (0, 180], got "
                              f"{self.min_facade_separation_deg}")
         for name in ("azimuth_smoothing_deg", "plane_gap_m", "min_facade_area_m2",
-                     "min_facade_area_fraction"):
+                     "min_facade_area_fraction", "plane_slab_m"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if not self.curve_strip_m > 0:
+            raise ValueError(f"curve_strip_m must be > 0, got {self.curve_strip_m}")
 
 
 @dataclass(frozen=True)
@@ -175,6 +205,100 @@ def group_facade_faces(
     return group
 
 
+@dataclass(frozen=True)
+class FacadePlanes:
+    """Facade planes of a mesh and the share of each triangle's area that counts on each.
+
+    ``azimuth_deg`` (K,) and ``offset_m`` (K,): plane k is {x : x.N_k = offset_m[k]}
+    with N_k the horizontal unit normal at ``azimuth_deg[k]``, in increasing
+    azimuth then offset. ``weight`` (F, K): the share of triangle f's area that
+    counts on plane k (n.N_k, its shadow on the plane, divided by the cosine of
+    its strip, see ``_strip_cosine``), else 0. ``residual`` (F,): 1 for facade
+    triangles near no plane within ``facade_max_tilt_deg`` of vertical (counted
+    with their full area), else 0.
+    """
+
+    azimuth_deg: np.ndarray
+    offset_m: np.ndarray
+    weight: np.ndarray
+    residual: np.ndarray
+
+
+def project_onto_facade_planes(
+    vertices_m: np.ndarray,
+    faces: np.ndarray,
+    vertex_labels: np.ndarray,
+    *,
+    config: MeasureConfig = MeasureConfig(),
+) -> FacadePlanes:
+    """Facade planes of a semantic mesh and the projected share of every triangle on them.
+
+    The facade groups propose planes; planes are taken greedily, most unclaimed
+    projected facade area first, each claiming the unclaimed triangles near it
+    (``plane_slab_m``) that face it (within ``plane_max_angle_deg``); proposals
+    left with less than the groups' minimum area are dropped. A triangle counts
+    on the plane that claimed it and also on any other taken plane it is near
+    and faces whose normal is at least ``plane_max_angle_deg`` away: the cut
+    corner between two walls (a marching-cubes chamfer) then projects onto both,
+    while the overlapping segments of one curved wall count it once.
+    """
+    vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
+    areas = class_area_m2(vertices_m, faces, labels)
+    facade_area = areas[:, list(FACADE_CLASSES)].sum(axis=1)
+    normal = _face_normals(vertices_m[faces])
+    centroid_xy = vertices_m[faces].mean(axis=1)[:, :2]
+    group = group_facade_faces(vertices_m, faces, labels, config=config)
+    idx = np.flatnonzero(facade_area > 0)
+    taken: list[int] = []
+    weight_i = np.zeros((len(idx), 0))
+    az_off: list[tuple[float, float]] = []
+    if group.max() >= 0 and len(idx):
+        az_off = [_azimuth_offset(normal[group == k], centroid_xy[group == k],
+                                  facade_area[group == k]) for k in range(group.max() + 1)]
+        az = np.radians([a for a, _ in az_off])
+        plane_n = np.stack([np.cos(az), np.sin(az)], axis=1)  # (K, 2)
+        facing = normal[idx, :2] @ plane_n.T  # (I, K) n.N
+        near = np.abs(centroid_xy[idx] @ plane_n.T - np.array([d for _, d in az_off]))
+        cos_max = np.cos(np.radians(config.plane_max_angle_deg))
+        inlier = (near <= config.plane_slab_m) & (facing >= cos_max)
+        support = facade_area[idx, None] * np.where(inlier, facing, 0.0)  # (I, K) m²
+        min_area = max(config.min_facade_area_m2,
+                       config.min_facade_area_fraction * float(facade_area[group >= 0].sum()))
+        claimed_by = np.full(len(idx), -1)
+        while True:
+            totals = support[claimed_by < 0].sum(axis=0)
+            totals[taken] = -1.0
+            k = int(np.argmax(totals))
+            if totals[k] < min_area:
+                break
+            claimed_by[(claimed_by < 0) & inlier[:, k]] = k
+            taken.append(k)
+        taken.sort(key=lambda k: az_off[k])
+        weight_i = np.zeros((len(idx), len(taken)))
+        for j, k in enumerate(taken):
+            apart = plane_n[claimed_by] @ plane_n[k] <= cos_max + 1e-9  # (I,) other facades
+            also = (claimed_by >= 0) & (claimed_by != k) & apart & inlier[:, k]
+            weight_i[also, j] = facing[also, k]
+            own = np.flatnonzero(claimed_by == k)
+            weight_i[own, j] = facing[own, k] / _strip_cosine(
+                normal[idx[own], :2], centroid_xy[idx[own]], facade_area[idx[own]],
+                plane_n[k], config.curve_strip_m, floor=cos_max)
+    weight = np.zeros((len(faces), len(taken)))
+    weight[idx] = weight_i
+    near_plane = np.zeros(len(faces), dtype=bool)
+    if taken:
+        near_plane[idx] = (near[:, taken] <= config.plane_slab_m).any(axis=1)
+    horizontal = np.linalg.norm(normal[:, :2], axis=1)
+    # a reveal or a recess side is near a plane it does not face: its shadow is 0, not its area
+    residual = (~near_plane & (facade_area > 0)
+                & (horizontal >= np.cos(np.radians(config.facade_max_tilt_deg)))).astype(float)
+    return FacadePlanes(
+        azimuth_deg=np.array([az_off[k][0] for k in taken]),
+        offset_m=np.array([az_off[k][1] for k in taken]),
+        weight=weight, residual=residual,
+    )
+
+
 def measure_semantic_mesh(
     vertices_m: np.ndarray,
     faces: np.ndarray,
@@ -197,13 +321,23 @@ def measure_semantic_mesh(
     """
     vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
     areas = class_area_m2(vertices_m, faces, labels)
-    group = group_facade_faces(vertices_m, faces, labels, config=config)
-    counted = areas if config.count == "all" else areas[group >= 0]
+    facade_classes = list(FACADE_CLASSES)
+    if config.count == "projected":
+        planes = project_onto_facade_planes(vertices_m, faces, labels, config=config)
+        counted = areas * (planes.weight.sum(axis=1) + planes.residual)[:, None]
+        facades = tuple(
+            _facade_figures(k, vertices_m, faces, areas * planes.weight[:, k, None],
+                            planes.weight[:, k] > 0, plane=(az, off))
+            for k, (az, off) in enumerate(zip(planes.azimuth_deg, planes.offset_m)))
+        ungrouped = float((areas[:, facade_classes].sum(axis=1) * planes.residual).sum())
+    else:
+        group = group_facade_faces(vertices_m, faces, labels, config=config)
+        counted = areas if config.count == "all" else areas[group >= 0]
+        facades = tuple(_facade_figures(i, vertices_m, faces, areas, group == i)
+                        for i in range(int(group.max()) + 1))
+        ungrouped = float(areas[group < 0][:, facade_classes].sum())
     window, wall, door = (float(counted[:, c].sum()) for c in
                           (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
-    facades = tuple(_facade_figures(i, vertices_m, faces, areas, group == i)
-                    for i in range(int(group.max()) + 1))
-    facade_classes = list(FACADE_CLASSES)
     return MeshMeasurement(
         window_area_m2=window,
         wall_area_m2=wall,
@@ -211,20 +345,23 @@ def measure_semantic_mesh(
         facade_area_m2=gross_facade_area_m2(wall, window, door),
         wwr=_wwr_or_none(window, wall, door),
         facades=facades,
-        ungrouped_facade_area_m2=float(areas[group < 0][:, facade_classes].sum()),
+        ungrouped_facade_area_m2=ungrouped,
     )
 
 
 def _facade_figures(
-    index: int, vertices_m: np.ndarray, faces: np.ndarray, areas: np.ndarray, mask: np.ndarray
+    index: int, vertices_m: np.ndarray, faces: np.ndarray, areas: np.ndarray, mask: np.ndarray,
+    plane: tuple[float, float] | None = None,
 ) -> MeshFacade:
+    """Figures of the triangles in ``mask``; ``plane`` (azimuth deg, offset m) if known."""
     tri = vertices_m[faces[mask]]
     a = areas[mask]
     window, wall, door = (float(a[:, c].sum()) for c in
                           (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
-    n = _face_normals(tri)
     weight = a[:, list(FACADE_CLASSES)].sum(axis=1)
-    azimuth, offset = _azimuth_offset(n, tri.mean(axis=1)[:, :2], weight)
+    azimuth, offset = plane if plane is not None else _azimuth_offset(
+        _face_normals(tri), tri.mean(axis=1)[:, :2], weight)
+    azimuth, offset = float(azimuth), float(offset)
     u = np.array([np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))])
     height = float(tri[..., 2].max() - tri[..., 2].min())
     gross = gross_facade_area_m2(wall, window, door)
@@ -243,6 +380,25 @@ def _facade_figures(
         face_count=int(mask.sum()),
         centre_m=tuple(float(c) for c in np.average(tri.mean(axis=1), axis=0, weights=weight)),
     )
+
+
+def _strip_cosine(normal_xy: np.ndarray, centroid_xy: np.ndarray, weight: np.ndarray,
+                  plane_normal_xy: np.ndarray, strip_m: float, *, floor: float) -> np.ndarray:
+    """(I,) cosine between the plane's normal and the mean normal of each triangle's strip.
+
+    The triangles are cut into vertical strips ``strip_m`` wide along the plane;
+    dividing a triangle's projected area by this cosine projects it onto its
+    strip's own mean plane instead: the same for a flat wall (cosine 1), the
+    true area for a wall curving away from the plane, still the shadow for a
+    recess or a ripple narrower than a strip. Clamped below at ``floor``.
+    """
+    tangent = np.array([-plane_normal_xy[1], plane_normal_xy[0]])
+    strip = np.floor(centroid_xy @ tangent / strip_m).astype(np.int64)
+    strip -= strip.min(initial=0)
+    mean = np.stack([np.bincount(strip, weights=weight * normal_xy[:, i]) for i in (0, 1)], 1)
+    length = np.linalg.norm(mean, axis=1)
+    cosine = np.divide(mean @ plane_normal_xy, length, out=np.ones(len(mean)), where=length > 0)
+    return np.maximum(cosine[strip], floor)
 
 
 def _azimuth_peaks_deg(azimuth_deg: np.ndarray, weight: np.ndarray,

@@ -42,7 +42,8 @@ def test_triangle_area_is_shared_by_vertex_classes():
 def test_box_with_window_band(banded_box):
     m = measure_semantic_mesh(*banded_box)
     assert m.facade_area_m2 == pytest.approx(2 * (6 + 4) * 10, rel=0.01)
-    assert m.window_area_m2 == pytest.approx(2 * (6 + 4) * 3, rel=0.01)
+    # each edge of the band may land half a voxel (0.04 m) off, all around the 20 m perimeter
+    assert m.window_area_m2 == pytest.approx(2 * (6 + 4) * 3, abs=20 * 0.08)
     assert m.wwr == pytest.approx(0.3, abs=0.01)
     assert m.facade_area_m2 == pytest.approx(m.wall_area_m2 + m.window_area_m2 + m.door_area_m2)
     assert [round(f.azimuth_deg) % 360 for f in m.facades] == [0, 90, 180, 270]
@@ -64,7 +65,10 @@ def test_cylinder_curved_facade():
 
     v, f, labels = _semantic_mesh(sdf, [-5, -7, -1], [7, 5, 11], (2.0, 5.0), 0.1)
     m = measure_semantic_mesh(v, f, labels)
-    assert m.facade_area_m2 == pytest.approx(2 * np.pi * 5 * 10, rel=0.01)
+    # projection onto 1 m strips keeps the curve (a 5 m radius: -0.2 %); the cut top and
+    # bottom rims lose up to a voxel each: 2 x 0.1 m x 31.4 m = 2 %
+    assert m.facade_area_m2 == pytest.approx(2 * np.pi * 5 * 10, rel=0.02)
+    assert m.facade_area_m2 <= 2 * np.pi * 5 * 10
     assert m.wwr == pytest.approx(0.3, abs=0.01)
     # no straight wall: greedy peaks are >= 30 degrees apart and leave no gap of 60, so the
     # curve is cut into segments 30 to 60 degrees wide
@@ -88,12 +92,63 @@ def test_grouping_config_and_ungrouped_area(banded_box):
     # the roof is no facade: only facade-class triangles may be grouped
     roof_only = (labels[f] == ROOF).all(axis=1)
     assert (group[roof_only] == -1).all()
-    strict = measure_semantic_mesh(v, f, labels, config=MeasureConfig(min_facade_area_m2=50.0))
+    strict = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
+        count="all", min_facade_area_m2=50.0))
     assert len(strict.facades) == 2  # only the 6 m wide (60 m²) facades stay
     assert strict.ungrouped_facade_area_m2 == pytest.approx(80, rel=0.02)
     grouped = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
         count="grouped", min_facade_area_m2=50.0))
     assert grouped.facade_area_m2 == pytest.approx(sum(fa.facade_area_m2 for fa in strict.facades))
+
+
+def _recessed_box():
+    """6 x 4 x 10 m box with two 1 x 1.2 m windows per side recessed 0.3 m, and an underside.
+
+    Labels: window on the pane and the reveals, roof on top, wall elsewhere, the
+    underside (z = 0) included, as a neural field closing the building at the
+    ground labels it. Truth: window 8 x 1.2 m², gross facade 200 m².
+    """
+    lo, hi = np.array([-3.0, -2.0, 0.0]), np.array([3.0, 2.0, 10.0])
+    recesses = []
+    for axis, size in ((0, 6.0), (1, 4.0)):  # windows on the faces normal to the other axis
+        other = 1 - axis
+        for side in (lo[other], hi[other]):
+            for u0 in (-0.5 * size + 1.0, 0.5 * size - 2.0):
+                r_lo, r_hi = np.array([0, 0, 4.0]), np.array([0, 0, 5.2])
+                r_lo[axis], r_hi[axis] = u0, u0 + 1.0
+                r_lo[other], r_hi[other] = side - 0.3, side + 0.3
+                recesses.append((r_lo, r_hi))
+
+    def sdf(p):
+        cut = np.min([box_sdf(p, a, b) for a, b in recesses], axis=0)
+        return np.maximum(box_sdf(p, lo, hi), -cut)
+
+    def label(p):
+        out = np.full(len(p), WALL)
+        inside_recess = np.any([(p >= a - 0.01).all(1) & (p <= b + 0.01).all(1)
+                                for a, b in recesses], axis=0)
+        out[inside_recess] = WINDOW
+        out[p[:, 2] > 10.0 - 0.01] = ROOF
+        return out
+
+    v, f = extract_mesh(sdf, [-4, -3, -1], [4, 3, 11], voxel_size_m=0.05)
+    return v, f, label_vertices(v, label)
+
+
+def test_projected_counts_recesses_and_underside_once():
+    v, f, labels = _recessed_box()
+    m = measure_semantic_mesh(v, f, labels)
+    # the openings' edges land up to half a voxel off: 8 windows x 4.4 m x 0.025 m = 0.9 m²
+    assert m.window_area_m2 == pytest.approx(8 * 1.2, abs=0.9)
+    assert m.facade_area_m2 == pytest.approx(200.0, rel=0.01)
+    assert m.wwr == pytest.approx(9.6 / 200.0, abs=0.005)
+    assert [round(fa.azimuth_deg) % 360 for fa in m.facades] == [0, 90, 180, 270]
+    for facade in m.facades:
+        assert facade.window_area_m2 == pytest.approx(2.4, abs=0.25)
+    # counting every triangle adds the reveals (8 x 4.4 m x 0.3 m) and the 24 m² underside
+    every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(count="all"))
+    assert every.window_area_m2 > m.window_area_m2 + 0.8 * 8 * 4.4 * 0.3
+    assert every.facade_area_m2 > m.facade_area_m2 + 0.9 * 24.0
 
 
 def test_mesh_without_facade_classes_has_no_wwr():
@@ -115,7 +170,8 @@ def test_bad_inputs(labels, faces, message):
 
 @pytest.mark.parametrize("kwargs", [
     {"count": "some"}, {"facade_max_tilt_deg": 90.0}, {"azimuth_bin_deg": 0.0},
-    {"min_facade_separation_deg": 0.0}, {"plane_gap_m": -1.0},
+    {"min_facade_separation_deg": 0.0}, {"plane_gap_m": -1.0}, {"plane_slab_m": -0.1},
+    {"plane_max_angle_deg": 90.0}, {"curve_strip_m": 0.0},
 ])
 def test_bad_config(kwargs):
     with pytest.raises(ValueError, match=next(iter(kwargs))):
