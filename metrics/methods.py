@@ -107,10 +107,12 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
 
     The result's config (the extraction config) gets the training config and a
     ``budget`` entry (preset, seconds), so a result trained otherwise is
-    recomputed; a requested resolution is checked against the stored one.
+    recomputed; a requested resolution and the measurement config
+    (``neural3d.measure.MeasureConfig``) are checked against the stored ones.
     Training (and torch) is imported only when a run is needed.
     """
     from neural3d.config import config_to_dict, preset_config
+    from neural3d.measure import MeasureConfig
 
     train_config = preset_config(budget.preset)
     if budget.eval_frames is not None:
@@ -137,7 +139,10 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
                              out_dir=run_dir / NEURAL3D_EXTRACT_FOLDER)
         return replace(result, config={**result.config, **extra})
 
-    requested = extra if budget.resolution is None else {**extra, "resolution": budget.resolution}
+    # a result measured another way (an older area count) is recomputed, not reused
+    requested = {**extra, "measure": asdict(MeasureConfig())}
+    if budget.resolution is not None:
+        requested["resolution"] = budget.resolution
     return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True)
 
 

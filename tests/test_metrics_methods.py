@@ -24,6 +24,14 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     assert n3d.config["budget"] == {"preset": "tiny", "max_seconds": 90.0}
     assert n3d.config["train"] == {**asdict(preset_config("tiny")), "eval_max_frames": 1}
     assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
+    # a stored result counted another way is not reused (runner.config_matches)
+    from metrics.runner import config_matches
+    from neural3d.measure import MeasureConfig
+
+    assert n3d.config["measure"] == asdict(MeasureConfig())
+    stored = {**n3d.config, "measure": asdict(MeasureConfig(count="all"))}
+    assert config_matches(n3d.config, {**n3d.config, "chunk_points": 1})
+    assert not config_matches(n3d.config, stored)
     (default,) = method_specs(("neural3d",), (), tmp_path)
     assert "resolution" not in default.config
 
