@@ -55,6 +55,13 @@ from scipy.ndimage import gaussian_filter1d
 from dataset.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
 from dataset.mesh import triangle_areas_m2
 from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+from neural3d.facade_planes import (
+    azimuth_offset,
+    circular_mean_deg,
+    face_normals,
+    project_onto_facade_planes,
+    wrap_deg,
+)
 
 
 @dataclass(frozen=True)
@@ -176,7 +183,7 @@ def group_facade_faces(
     vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
     areas = class_area_m2(vertices_m, faces, labels)
     facade_area = areas[:, list(FACADE_CLASSES)].sum(axis=1)
-    normal = _face_normals(vertices_m[faces])
+    normal = face_normals(vertices_m[faces])
     horizontal = np.linalg.norm(normal[:, :2], axis=1)
     candidate = (facade_area > 0) & (horizontal >= np.cos(np.radians(config.facade_max_tilt_deg)))
     group = np.full(len(faces), -1, dtype=np.int64)
@@ -185,12 +192,12 @@ def group_facade_faces(
         return group
     azimuth = np.degrees(np.arctan2(normal[idx, 1], normal[idx, 0])) % 360.0
     peaks = _azimuth_peaks_deg(azimuth, facade_area[idx], config)
-    nearest = np.argmin(np.abs(_wrap_deg(azimuth[:, None] - peaks[None, :])), axis=1)
+    nearest = np.argmin(np.abs(wrap_deg(azimuth[:, None] - peaks[None, :])), axis=1)
     centroid_xy = vertices_m[faces].mean(axis=1)[:, :2]
     groups: list[np.ndarray] = []
     for k in range(len(peaks)):
         members = idx[nearest == k]
-        mean_az = _circular_mean_deg(azimuth[nearest == k], facade_area[members])
+        mean_az = circular_mean_deg(azimuth[nearest == k], facade_area[members])
         u = np.array([np.cos(np.radians(mean_az)), np.sin(np.radians(mean_az))])
         offsets = centroid_xy[members] @ u
         order = np.argsort(offsets)
@@ -199,104 +206,10 @@ def group_facade_faces(
     total = sum(float(facade_area[g].sum()) for g in groups)
     min_area = max(config.min_facade_area_m2, config.min_facade_area_fraction * total)
     kept = [g for g in groups if facade_area[g].sum() >= min_area]
-    for i, members in enumerate(sorted(kept, key=lambda g: _azimuth_offset(
+    for i, members in enumerate(sorted(kept, key=lambda g: azimuth_offset(
             normal[g], centroid_xy[g], facade_area[g]))):
         group[members] = i
     return group
-
-
-@dataclass(frozen=True)
-class FacadePlanes:
-    """Facade planes of a mesh and the share of each triangle's area that counts on each.
-
-    ``azimuth_deg`` (K,) and ``offset_m`` (K,): plane k is {x : x.N_k = offset_m[k]}
-    with N_k the horizontal unit normal at ``azimuth_deg[k]``, in increasing
-    azimuth then offset. ``weight`` (F, K): the share of triangle f's area that
-    counts on plane k (n.N_k, its shadow on the plane, divided by the cosine of
-    its strip, see ``_strip_cosine``), else 0. ``residual`` (F,): 1 for facade
-    triangles near no plane within ``facade_max_tilt_deg`` of vertical (counted
-    with their full area), else 0.
-    """
-
-    azimuth_deg: np.ndarray
-    offset_m: np.ndarray
-    weight: np.ndarray
-    residual: np.ndarray
-
-
-def project_onto_facade_planes(
-    vertices_m: np.ndarray,
-    faces: np.ndarray,
-    vertex_labels: np.ndarray,
-    *,
-    config: MeasureConfig = MeasureConfig(),
-) -> FacadePlanes:
-    """Facade planes of a semantic mesh and the projected share of every triangle on them.
-
-    The facade groups propose planes; planes are taken greedily, most unclaimed
-    projected facade area first, each claiming the unclaimed triangles near it
-    (``plane_slab_m``) that face it (within ``plane_max_angle_deg``); proposals
-    left with less than the groups' minimum area are dropped. A triangle counts
-    on the plane that claimed it and also on any other taken plane it is near
-    and faces whose normal is at least ``plane_max_angle_deg`` away: the cut
-    corner between two walls (a marching-cubes chamfer) then projects onto both,
-    while the overlapping segments of one curved wall count it once.
-    """
-    vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
-    areas = class_area_m2(vertices_m, faces, labels)
-    facade_area = areas[:, list(FACADE_CLASSES)].sum(axis=1)
-    normal = _face_normals(vertices_m[faces])
-    centroid_xy = vertices_m[faces].mean(axis=1)[:, :2]
-    group = group_facade_faces(vertices_m, faces, labels, config=config)
-    idx = np.flatnonzero(facade_area > 0)
-    taken: list[int] = []
-    weight_i = np.zeros((len(idx), 0))
-    az_off: list[tuple[float, float]] = []
-    if group.max() >= 0 and len(idx):
-        az_off = [_azimuth_offset(normal[group == k], centroid_xy[group == k],
-                                  facade_area[group == k]) for k in range(group.max() + 1)]
-        az = np.radians([a for a, _ in az_off])
-        plane_n = np.stack([np.cos(az), np.sin(az)], axis=1)  # (K, 2)
-        facing = normal[idx, :2] @ plane_n.T  # (I, K) n.N
-        near = np.abs(centroid_xy[idx] @ plane_n.T - np.array([d for _, d in az_off]))
-        cos_max = np.cos(np.radians(config.plane_max_angle_deg))
-        inlier = (near <= config.plane_slab_m) & (facing >= cos_max)
-        support = facade_area[idx, None] * np.where(inlier, facing, 0.0)  # (I, K) m²
-        min_area = max(config.min_facade_area_m2,
-                       config.min_facade_area_fraction * float(facade_area[group >= 0].sum()))
-        claimed_by = np.full(len(idx), -1)
-        while True:
-            totals = support[claimed_by < 0].sum(axis=0)
-            totals[taken] = -1.0
-            k = int(np.argmax(totals))
-            if totals[k] < min_area:
-                break
-            claimed_by[(claimed_by < 0) & inlier[:, k]] = k
-            taken.append(k)
-        taken.sort(key=lambda k: az_off[k])
-        weight_i = np.zeros((len(idx), len(taken)))
-        for j, k in enumerate(taken):
-            apart = plane_n[claimed_by] @ plane_n[k] <= cos_max + 1e-9  # (I,) other facades
-            also = (claimed_by >= 0) & (claimed_by != k) & apart & inlier[:, k]
-            weight_i[also, j] = facing[also, k]
-            own = np.flatnonzero(claimed_by == k)
-            weight_i[own, j] = facing[own, k] / _strip_cosine(
-                normal[idx[own], :2], centroid_xy[idx[own]], facade_area[idx[own]],
-                plane_n[k], config.curve_strip_m, floor=cos_max)
-    weight = np.zeros((len(faces), len(taken)))
-    weight[idx] = weight_i
-    near_plane = np.zeros(len(faces), dtype=bool)
-    if taken:
-        near_plane[idx] = (near[:, taken] <= config.plane_slab_m).any(axis=1)
-    horizontal = np.linalg.norm(normal[:, :2], axis=1)
-    # a reveal or a recess side is near a plane it does not face: its shadow is 0, not its area
-    residual = (~near_plane & (facade_area > 0)
-                & (horizontal >= np.cos(np.radians(config.facade_max_tilt_deg)))).astype(float)
-    return FacadePlanes(
-        azimuth_deg=np.array([az_off[k][0] for k in taken]),
-        offset_m=np.array([az_off[k][1] for k in taken]),
-        weight=weight, residual=residual,
-    )
 
 
 def measure_semantic_mesh(
@@ -323,7 +236,9 @@ def measure_semantic_mesh(
     areas = class_area_m2(vertices_m, faces, labels)
     facade_classes = list(FACADE_CLASSES)
     if config.count == "projected":
-        planes = project_onto_facade_planes(vertices_m, faces, labels, config=config)
+        facade_area = areas[:, facade_classes].sum(axis=1)
+        group = group_facade_faces(vertices_m, faces, labels, config=config)
+        planes = project_onto_facade_planes(vertices_m, faces, facade_area, group, config=config)
         counted = areas * (planes.weight.sum(axis=1) + planes.residual)[:, None]
         facades = tuple(
             _facade_figures(k, vertices_m, faces, areas * planes.weight[:, k, None],
@@ -359,8 +274,8 @@ def _facade_figures(
     window, wall, door = (float(a[:, c].sum()) for c in
                           (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
     weight = a[:, list(FACADE_CLASSES)].sum(axis=1)
-    azimuth, offset = plane if plane is not None else _azimuth_offset(
-        _face_normals(tri), tri.mean(axis=1)[:, :2], weight)
+    azimuth, offset = plane if plane is not None else azimuth_offset(
+        face_normals(tri), tri.mean(axis=1)[:, :2], weight)
     azimuth, offset = float(azimuth), float(offset)
     u = np.array([np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))])
     height = float(tri[..., 2].max() - tri[..., 2].min())
@@ -382,25 +297,6 @@ def _facade_figures(
     )
 
 
-def _strip_cosine(normal_xy: np.ndarray, centroid_xy: np.ndarray, weight: np.ndarray,
-                  plane_normal_xy: np.ndarray, strip_m: float, *, floor: float) -> np.ndarray:
-    """(I,) cosine between the plane's normal and the mean normal of each triangle's strip.
-
-    The triangles are cut into vertical strips ``strip_m`` wide along the plane;
-    dividing a triangle's projected area by this cosine projects it onto its
-    strip's own mean plane instead: the same for a flat wall (cosine 1), the
-    true area for a wall curving away from the plane, still the shadow for a
-    recess or a ripple narrower than a strip. Clamped below at ``floor``.
-    """
-    tangent = np.array([-plane_normal_xy[1], plane_normal_xy[0]])
-    strip = np.floor(centroid_xy @ tangent / strip_m).astype(np.int64)
-    strip -= strip.min(initial=0)
-    mean = np.stack([np.bincount(strip, weights=weight * normal_xy[:, i]) for i in (0, 1)], 1)
-    length = np.linalg.norm(mean, axis=1)
-    cosine = np.divide(mean @ plane_normal_xy, length, out=np.ones(len(mean)), where=length > 0)
-    return np.maximum(cosine[strip], floor)
-
-
 def _azimuth_peaks_deg(azimuth_deg: np.ndarray, weight: np.ndarray,
                        config: MeasureConfig) -> np.ndarray:
     n_bins = max(1, int(round(360.0 / config.azimuth_bin_deg)))
@@ -415,34 +311,8 @@ def _azimuth_peaks_deg(azimuth_deg: np.ndarray, weight: np.ndarray,
     while hist.max() > floor:
         i = int(np.argmax(hist))
         peaks.append(centres[i])
-        hist[np.abs(_wrap_deg(centres - centres[i])) < config.min_facade_separation_deg] = 0.0
+        hist[np.abs(wrap_deg(centres - centres[i])) < config.min_facade_separation_deg] = 0.0
     return np.array(peaks)
-
-
-def _azimuth_offset(
-    normal: np.ndarray, centroid_xy: np.ndarray, weight: np.ndarray
-) -> tuple[float, float]:
-    """Weighted mean azimuth (deg) of faces and their mean offset (m) along it."""
-    az = _circular_mean_deg(np.degrees(np.arctan2(normal[:, 1], normal[:, 0])), weight)
-    u = np.array([np.cos(np.radians(az)), np.sin(np.radians(az))])
-    return az, float(np.average(centroid_xy @ u, weights=weight))
-
-
-def _circular_mean_deg(angle_deg: np.ndarray, weight: np.ndarray) -> float:
-    r = np.radians(angle_deg)
-    return float(np.degrees(np.arctan2((weight * np.sin(r)).sum(),
-                                       (weight * np.cos(r)).sum())) % 360.0)
-
-
-def _wrap_deg(delta_deg: np.ndarray) -> np.ndarray:
-    """Angle differences wrapped into [-180, 180)."""
-    return (delta_deg + 180.0) % 360.0 - 180.0
-
-
-def _face_normals(triangles_m: np.ndarray) -> np.ndarray:
-    n = np.cross(triangles_m[:, 1] - triangles_m[:, 0], triangles_m[:, 2] - triangles_m[:, 0])
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
 def _wwr_or_none(window: float, wall: float, door: float) -> float | None:
