@@ -107,7 +107,7 @@ def main() -> int:
             oracle = OracleField(building.mesh, spacing_m=voxel / 3)
             v, f = extract_mesh(oracle.sdf, lo, hi, resolution=res)
             labels = label_vertices(v, oracle.labels)
-            poly = footprint_from_sdf(oracle.sdf, lo, hi, height_m=0.5, cell_m=voxel / 2,
+            poly = footprint_from_sdf(oracle.sdf, lo, hi, heights_m=(0.5,), cell_m=voxel / 2,
                                       min_area_m2=1.0)
             truth_fp = shape(truth.footprint)
             iou = poly.intersection(truth_fp).area / poly.union(truth_fp).area

@@ -55,6 +55,8 @@ class MethodResult:
     ``footprint`` is a GeoJSON Polygon in world x/y metres, or ``None`` for
     methods that do not estimate one. ``config`` is the method's full config;
     ``code_version`` the git commit (or package version) that produced it.
+    ``config`` is kept as it reads back from JSON (tuples become lists), so a
+    result equals itself after a write and a read.
     """
 
     scene: str
@@ -70,6 +72,9 @@ class MethodResult:
     wall_time_s: float = 0.0
     warnings: tuple[str, ...] = ()
     schema_version: int = RESULT_SCHEMA_VERSION
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "config", json.loads(json.dumps(self.config)))
 
     def to_json_dict(self) -> dict[str, Any]:
         d = asdict(self)

@@ -1,9 +1,12 @@
-"""Building footprint: the zero contour of an SDF on a horizontal plane, as a shapely polygon.
+"""Building footprint: the zero contour of an SDF near the ground, as a shapely polygon.
 
-The SDF is sampled on a square grid of ``cell_m`` over the box's x/y extent at
-``z = height_m`` (default in :class:`neural3d.extract.ExtractConfig`: 0.5 m,
-above a ground plane's reconstruction noise and below window sills and
-overhangs). The grid is padded with one ring of positive (outside) samples so
+The SDF is sampled on a square grid of ``cell_m`` over the box's x/y extent on
+one or more horizontal planes ``z = heights_m`` and averaged over them
+(defaults in :class:`neural3d.extract.ExtractConfig`: 1 to 4 m, above the
+ground plane's reconstruction noise and below balconies and overhangs). Across
+a vertical wall the SDF does not change with z, so the average keeps the wall
+where it is while the independent wobbles of a trained field on each plane
+cancel. The grid is padded with one ring of positive (outside) samples so
 that every contour closes, even where the building meets the box edge; the
 zero contours (``skimage.measure.find_contours``, linear interpolation) become
 rings, and nesting is resolved by even-odd (symmetric difference), which keeps
@@ -11,6 +14,8 @@ courtyards as holes. Pieces and holes smaller than ``min_area_m2`` are dropped.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
@@ -52,21 +57,22 @@ def footprint_from_sdf(
     box_min_m: np.ndarray,
     box_max_m: np.ndarray,
     *,
-    height_m: float,
+    heights_m: Sequence[float],
     cell_m: float,
     min_area_m2: float,
     chunk_points: int = DEFAULT_CHUNK_POINTS,
 ) -> Polygon | MultiPolygon:
-    """Footprint polygon (world x/y metres) where the SDF is negative on the plane ``z = height_m``.
+    """Footprint polygon (world x/y metres) where the SDF averaged over planes is negative.
 
     Parameters
     ----------
     sdf_fn : callable (N, 3) -> (N,)
         Signed distance in m, positive outside.
     box_min_m, box_max_m : (3,) float
-        Scene box; its x/y extent is sampled and ``height_m`` must lie in its z range.
-    height_m : float
-        Height of the cutting plane in m above the world origin (ground at z = 0).
+        Scene box; its x/y extent is sampled and ``heights_m`` must lie in its z range.
+    heights_m : sequence of float
+        Heights of the planes in m above the world origin (ground at z = 0) over
+        which the SDF is averaged; one value cuts a single plane.
     cell_m : float
         Grid spacing in m.
     min_area_m2 : float
@@ -83,9 +89,13 @@ def footprint_from_sdf(
         it, nothing is left after dropping small pieces, or on bad arguments.
     """
     lo, hi = check_box(box_min_m, box_max_m)
-    if not lo[2] <= height_m <= hi[2]:
-        raise ValueError(f"footprint height {height_m} m lies outside the box's z range "
-                         f"[{lo[2]:.3g}, {hi[2]:.3g}] m")
+    heights = [float(h) for h in heights_m]
+    if not heights:
+        raise ValueError("heights_m is empty: give at least one footprint height")
+    for height_m in heights:
+        if not lo[2] <= height_m <= hi[2]:
+            raise ValueError(f"footprint height {height_m} m lies outside the box's z range "
+                             f"[{lo[2]:.3g}, {hi[2]:.3g}] m")
     if not np.isfinite(cell_m) or cell_m <= 0:
         raise ValueError(f"cell_m must be > 0, got {cell_m}")
     if min_area_m2 < 0:
@@ -95,12 +105,14 @@ def footprint_from_sdf(
         raise ValueError(f"footprint grid of {tuple(counts)} cells is too large (at most "
                          f"{MAX_FOOTPRINT_CELLS} per axis); raise cell_m")
     xs, ys = (lo[i] + cell_m * np.arange(max(counts[i], 2)) for i in range(2))
-    values = sample_sdf_plane(sdf_fn, xs, ys, height_m, chunk_points=chunk_points)
+    values = np.mean([sample_sdf_plane(sdf_fn, xs, ys, h, chunk_points=chunk_points)
+                      for h in heights], axis=0)
+    where = f"z = {heights[0]} m" if len(heights) == 1 else f"z = {heights} m"
     if values.min() >= 0:
-        raise ValueError(f"the plane z = {height_m} m misses the building (the SDF is positive "
-                         "everywhere on it); choose a footprint height within the building")
+        raise ValueError(f"the plane(s) {where} miss the building (the SDF is positive "
+                         "everywhere on them); choose footprint heights within the building")
     if values.max() <= 0:
-        raise ValueError(f"the plane z = {height_m} m lies wholly inside the surface; the box is "
+        raise ValueError(f"the plane(s) {where} lie wholly inside the surface; the box is "
                          "too small or the field is degenerate")
     return _polygon_from_grid(values, xs[0], ys[0], cell_m, min_area_m2)
 

@@ -148,8 +148,10 @@ def test_result_file_round_trip(tmp_path):
         scene="s", method="2D-SS", protocol="ideal", wwr=0.3, window_area_m2=30.0,
         facade_area_m2=100.0, facades=(FacadeEstimate(id=1, wwr=0.3), FacadeEstimate(
             id=2, wwr=None, missing=True, reason="no usable view")),
-        config={"a": 1}, code_version="x", wall_time_s=1.5, warnings=("w",),
+        config={"a": 1, "heights": (1.0, 2.0)}, code_version="x", wall_time_s=1.5,
+        warnings=("w",),
     )
+    assert r.config["heights"] == [1.0, 2.0]  # kept as JSON reads it back
     path = write_result(tmp_path, r)
     assert read_result(path) == r
     located = replace(r, facades=(FacadeEstimate(id=1, wwr=0.3, normal=(0.0, -1.0, 0.0),

@@ -17,7 +17,7 @@ def _iou(a, b) -> float:
 
 
 def _footprint(sdf, **kwargs):
-    args = {"height_m": 0.5, "cell_m": 0.1, "min_area_m2": 1.0, **kwargs}
+    args = {"heights_m": (0.5,), "cell_m": 0.1, "min_area_m2": 1.0, **kwargs}
     return footprint_from_sdf(sdf, SCENE_LO, SCENE_HI, **args)
 
 
@@ -65,14 +65,45 @@ def test_separate_pieces_and_slivers():
 
 
 def test_plane_that_misses_the_building():
-    with pytest.raises(ValueError, match="misses the building"):
-        _footprint(l_prism_sdf, height_m=9.0)  # above the 8 m roof
+    with pytest.raises(ValueError, match="miss the building"):
+        _footprint(l_prism_sdf, heights_m=(9.0,))  # above the 8 m roof
     with pytest.raises(ValueError, match="outside the box"):
-        _footprint(l_prism_sdf, height_m=12.0)
+        _footprint(l_prism_sdf, heights_m=(1.0, 12.0))
+    with pytest.raises(ValueError, match="at least one"):
+        _footprint(l_prism_sdf, heights_m=())
     with pytest.raises(ValueError, match="wholly inside"):
         _footprint(lambda p: np.full(len(p), -1.0))
     with pytest.raises(ValueError, match="no footprint piece"):
         _footprint(l_prism_sdf, min_area_m2=100.0)
+
+
+def test_averaging_planes_cancels_wobbles_of_the_walls():
+    """A 10 x 6 m box whose walls sit +-0.15 m off, alternating with height, on the planes.
+
+    On each plane alone the footprint is 0.3 m too wide or too narrow; the SDF
+    averaged over the four planes puts every wall back where it is.
+    """
+    truth = rectangle(0, 0, 10, 6)
+
+    def wobbly(p):
+        offset = np.where(np.floor(p[:, 2] / 0.5) % 2 == 0, 0.15, -0.15)  # 1.0, 2.0: +0.15
+        return box_sdf(p, [0, 0, 0], [10, 6, 8]) - offset
+
+    one = _footprint(wobbly, heights_m=(1.0,))
+    assert one.area == pytest.approx(10.3 * 6.3, rel=1e-3)
+    band = _footprint(wobbly, heights_m=(1.0, 1.5, 2.0, 2.5))
+    assert _iou(band, truth) >= 0.995 > 0.97 > _iou(one, truth)
+
+
+def test_extract_keeps_footprint_planes_below_half_the_box():
+    from neural3d.extract import ExtractConfig, footprint_heights_m
+
+    config = ExtractConfig()
+    assert footprint_heights_m(np.array([5.0, 5.0, 20.0]), config) == config.footprint_heights_m
+    assert footprint_heights_m(np.array([5.0, 5.0, 4.0]), config) == (1.0, 1.5, 2.0)
+    assert footprint_heights_m(np.array([5.0, 5.0, 1.0]), config) == (1.0,)  # the lowest stays
+    with pytest.raises(ValueError, match="footprint_heights_m"):
+        ExtractConfig(footprint_heights_m=())
 
 
 @pytest.mark.parametrize("kwargs, message", [
