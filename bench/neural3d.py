@@ -137,7 +137,7 @@ def _on_target(row: dict) -> bool:
 
 
 def converge(args: argparse.Namespace) -> dict:
-    from neural3d.extract import ExtractConfig
+    from neural3d.extract_config import ExtractConfig
 
     device = resolve_device(args.device)
     config = replace(with_overrides(preset_config("fast"), args.set),

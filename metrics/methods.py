@@ -105,14 +105,14 @@ def debug_images_2dss(scene_dir: Path, protocol: str, debug_dir: Path) -> None:
 def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
     """neural3d: time-limited training (``neural3d.train``) then extraction (``neural3d.extract``).
 
-    The result's config (the extraction config) gets the training config and a
-    ``budget`` entry (preset, seconds), so a result trained otherwise is
-    recomputed; a requested resolution and the measurement config
-    (``neural3d.measure.MeasureConfig``) are checked against the stored ones.
+    The result's config is the whole extraction config
+    (``neural3d.extract_config.ExtractConfig``: resolution, footprint planes,
+    measurement) plus the training config and a ``budget`` entry (preset,
+    seconds), so a result trained, meshed or measured otherwise is recomputed.
     Training (and torch) is imported only when a run is needed.
     """
     from neural3d.config import config_to_dict, preset_config
-    from neural3d.measure import MeasureConfig
+    from neural3d.extract_config import ExtractConfig
 
     train_config = preset_config(budget.preset)
     if budget.eval_frames is not None:
@@ -122,27 +122,24 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
         "budget": {"preset": budget.preset, "max_seconds": budget.minutes * 60.0},
         "train": config_to_dict(train_config),
     }
+    extract = ExtractConfig() if budget.resolution is None else ExtractConfig(
+        resolution=budget.resolution)
 
     def run(scene_dir: Path, protocol: str):
         import torch
 
         # isort sees a module as first-party only once its file exists: keep this block as is.
-        from neural3d.extract import ExtractConfig, extract_run  # noqa: I001
+        from neural3d.extract import extract_run  # noqa: I001
         from neural3d.train import train
 
         device = torch.device(budget.device)
         run_dir = train(scene_dir, train_config, runs_dir, device=device,
                         max_seconds=budget.minutes * 60.0)
-        extract = ExtractConfig() if budget.resolution is None else ExtractConfig(
-            resolution=budget.resolution)
         result = extract_run(run_dir, config=extract, device=device,
                              out_dir=run_dir / NEURAL3D_EXTRACT_FOLDER)
         return replace(result, config={**result.config, **extra})
 
-    # a result measured another way (an older area count) is recomputed, not reused
-    requested = {**extra, "measure": asdict(MeasureConfig())}
-    if budget.resolution is not None:
-        requested["resolution"] = budget.resolution
+    requested = {**asdict(extract), **extra}
     return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True)
 
 

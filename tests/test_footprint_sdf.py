@@ -96,7 +96,7 @@ def test_averaging_planes_cancels_wobbles_of_the_walls():
 
 
 def test_extract_keeps_footprint_planes_below_half_the_box():
-    from neural3d.extract import ExtractConfig, footprint_heights_m
+    from neural3d.extract_config import ExtractConfig, footprint_heights_m
 
     config = ExtractConfig()
     assert footprint_heights_m(np.array([5.0, 5.0, 20.0]), config) == config.footprint_heights_m

@@ -24,16 +24,18 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     assert n3d.config["budget"] == {"preset": "tiny", "max_seconds": 90.0}
     assert n3d.config["train"] == {**asdict(preset_config("tiny")), "eval_max_frames": 1}
     assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
-    # a stored result counted another way is not reused (runner.config_matches)
+    # a stored result meshed or measured another way is not reused (runner.config_matches)
     from metrics.runner import config_matches
+    from neural3d.extract_config import ExtractConfig
     from neural3d.measure import MeasureConfig
 
     assert n3d.config["measure"] == asdict(MeasureConfig())
-    stored = {**n3d.config, "measure": asdict(MeasureConfig(count="all"))}
-    assert config_matches(n3d.config, {**n3d.config, "chunk_points": 1})
-    assert not config_matches(n3d.config, stored)
+    assert config_matches(n3d.config, {**n3d.config, "extra_key": 1})
+    assert not config_matches(n3d.config, {**n3d.config,
+                                           "measure": asdict(MeasureConfig(count="all"))})
+    assert not config_matches(n3d.config, {**n3d.config, "footprint_heights_m": [1.0]})
     (default,) = method_specs(("neural3d",), (), tmp_path)
-    assert "resolution" not in default.config
+    assert default.config["resolution"] == ExtractConfig().resolution
 
 
 def test_read_only_specs_never_run():
