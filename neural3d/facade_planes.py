@@ -24,9 +24,9 @@ class FacadePlanes:
     azimuth then offset. ``weight`` (F, K): the share of triangle f's area that
     counts on plane k (n.N_k, its shadow on the plane, divided by the cosine of
     its strip, see ``_strip_cosine``, unless it is a corner counted on two
-    planes), else 0. ``residual`` (F,): 1 for facade
-    triangles near no plane within ``facade_max_tilt_deg`` of vertical (counted
-    with their full area), else 0.
+    planes), else 0. ``residual`` (F,): 1 for facade triangles near no plane
+    within ``facade_max_tilt_deg`` of vertical (counted with their full area),
+    else 0.
     """
 
     azimuth_deg: np.ndarray
@@ -45,14 +45,6 @@ def project_onto_facade_planes(
 ) -> FacadePlanes:
     """Facade planes of a semantic mesh and the projected share of every triangle on them.
 
-    Parameters
-    ----------
-    vertices_m : (V, 3) float64, world metres; faces : (F, 3) int64, outward
-    facade_area_m2 : (F,) wall + window + door share of each triangle's area
-        (``neural3d.measure.class_area_m2``)
-    group : (F,) facade group from ``neural3d.measure.group_facade_faces`` (-1 none)
-    config : ``neural3d.measure.MeasureConfig``
-
     The facade groups propose planes; planes are taken greedily, most unclaimed
     projected facade area first, each claiming the unclaimed triangles near it
     (``plane_slab_m``) that face it (within ``plane_max_angle_deg``); proposals
@@ -61,8 +53,16 @@ def project_onto_facade_planes(
     and faces whose normal is at least ``plane_max_angle_deg`` away: the cut
     corner between two walls (a marching-cubes chamfer) then projects onto both,
     while the overlapping segments of one curved wall count it once.
+
+    Parameters
+    ----------
+    vertices_m : (V, 3) float64, world metres; faces : (F, 3) int64, outward
+    facade_area_m2 : (F,) wall + window + door share of each triangle's area
+        (``neural3d.measure.class_area_m2``)
+    group : (F,) facade group from ``neural3d.measure.group_facade_faces`` (-1 none)
+    config : ``neural3d.measure.MeasureConfig``
     """
-    facade_area = facade_area_m2
+    facade_area = facade_area_m2  # (F,) m²
     normal = face_normals(vertices_m[faces])
     centroid_xy = vertices_m[faces].mean(axis=1)[:, :2]
     idx = np.flatnonzero(facade_area > 0)
