@@ -62,25 +62,23 @@ def project_onto_facade_planes(
     group : (F,) facade group from ``neural3d.measure.group_facade_faces`` (-1 none)
     config : ``neural3d.measure.MeasureConfig``
     """
-    facade_area = facade_area_m2  # (F,) m²
     normal = face_normals(vertices_m[faces])
     centroid_xy = vertices_m[faces].mean(axis=1)[:, :2]
-    idx = np.flatnonzero(facade_area > 0)
+    idx = np.flatnonzero(facade_area_m2 > 0)
     taken: list[int] = []
     weight_i = np.zeros((len(idx), 0))
     az_off: list[tuple[float, float]] = []
     if group.max() >= 0 and len(idx):
         az_off = [azimuth_offset(normal[group == k], centroid_xy[group == k],
-                                  facade_area[group == k]) for k in range(group.max() + 1)]
+                                  facade_area_m2[group == k]) for k in range(group.max() + 1)]
         az = np.radians([a for a, _ in az_off])
         plane_n = np.stack([np.cos(az), np.sin(az)], axis=1)  # (K, 2)
         facing = normal[idx, :2] @ plane_n.T  # (I, K) n.N
         near = np.abs(centroid_xy[idx] @ plane_n.T - np.array([d for _, d in az_off]))
         cos_max = np.cos(np.radians(config.plane_max_angle_deg))
         inlier = (near <= config.plane_slab_m) & (facing >= cos_max)
-        support = facade_area[idx, None] * np.where(inlier, facing, 0.0)  # (I, K) m²
-        min_area = max(config.min_facade_area_m2,
-                       config.min_facade_area_fraction * float(facade_area[group >= 0].sum()))
+        support = facade_area_m2[idx, None] * np.where(inlier, facing, 0.0)  # (I, K) m²
+        min_area = config.min_group_area_m2(float(facade_area_m2[group >= 0].sum()))
         claimed_by = np.full(len(idx), -1)
         while True:
             totals = support[claimed_by < 0].sum(axis=0)
@@ -102,7 +100,7 @@ def project_onto_facade_planes(
             weight_i[own & corner, j] = facing[own & corner, k]
             flat = np.flatnonzero(own & ~corner)  # a corner is two walls' shadows, not a curve
             weight_i[flat, j] = facing[flat, k] / _strip_cosine(
-                normal[idx[flat], :2], centroid_xy[idx[flat]], facade_area[idx[flat]],
+                normal[idx[flat], :2], centroid_xy[idx[flat]], facade_area_m2[idx[flat]],
                 plane_n[k], config.curve_strip_m, floor=cos_max)
     weight = np.zeros((len(faces), len(taken)))
     weight[idx] = weight_i
@@ -111,7 +109,7 @@ def project_onto_facade_planes(
         near_plane[idx] = (near[:, taken] <= config.plane_slab_m).any(axis=1)
     horizontal = np.linalg.norm(normal[:, :2], axis=1)
     # a reveal or a recess side is near a plane it does not face: its shadow is 0, not its area
-    residual = (~near_plane & (facade_area > 0)
+    residual = (~near_plane & (facade_area_m2 > 0)
                 & (horizontal >= np.cos(np.radians(config.facade_max_tilt_deg)))).astype(float)
     return FacadePlanes(
         azimuth_deg=np.array([az_off[k][0] for k in taken]),

@@ -108,6 +108,10 @@ class MeasureConfig:
         if not self.curve_strip_m > 0:
             raise ValueError(f"curve_strip_m must be > 0, got {self.curve_strip_m}")
 
+    def min_group_area_m2(self, grouped_area_m2: float) -> float:
+        """Smallest facade group (or plane) kept, given the grouped facade area in m²."""
+        return max(self.min_facade_area_m2, self.min_facade_area_fraction * grouped_area_m2)
+
 
 @dataclass(frozen=True)
 class MeshFacade:
@@ -181,8 +185,13 @@ def group_facade_faces(
     triangles in no facade.
     """
     vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
-    areas = class_area_m2(vertices_m, faces, labels)
-    facade_area = areas[:, list(FACADE_CLASSES)].sum(axis=1)
+    facade_area = class_area_m2(vertices_m, faces, labels)[:, list(FACADE_CLASSES)].sum(axis=1)
+    return _group_faces(vertices_m, faces, facade_area, config)
+
+
+def _group_faces(vertices_m: np.ndarray, faces: np.ndarray, facade_area: np.ndarray,
+                 config: MeasureConfig) -> np.ndarray:
+    """:func:`group_facade_faces` on checked inputs and (F,) facade-class areas in m²."""
     normal = face_normals(vertices_m[faces])
     horizontal = np.linalg.norm(normal[:, :2], axis=1)
     candidate = (facade_area > 0) & (horizontal >= np.cos(np.radians(config.facade_max_tilt_deg)))
@@ -203,8 +212,7 @@ def group_facade_faces(
         order = np.argsort(offsets)
         cuts = np.flatnonzero(np.diff(offsets[order]) > config.plane_gap_m) + 1
         groups.extend(members[order][piece] for piece in np.split(np.arange(len(order)), cuts))
-    total = sum(float(facade_area[g].sum()) for g in groups)
-    min_area = max(config.min_facade_area_m2, config.min_facade_area_fraction * total)
+    min_area = config.min_group_area_m2(sum(float(facade_area[g].sum()) for g in groups))
     kept = [g for g in groups if facade_area[g].sum() >= min_area]
     for i, members in enumerate(sorted(kept, key=lambda g: azimuth_offset(
             normal[g], centroid_xy[g], facade_area[g]))):
@@ -235,9 +243,9 @@ def measure_semantic_mesh(
     vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
     areas = class_area_m2(vertices_m, faces, labels)
     facade_classes = list(FACADE_CLASSES)
+    facade_area = areas[:, facade_classes].sum(axis=1)
+    group = _group_faces(vertices_m, faces, facade_area, config)
     if config.count == "projected":
-        facade_area = areas[:, facade_classes].sum(axis=1)
-        group = group_facade_faces(vertices_m, faces, labels, config=config)
         planes = project_onto_facade_planes(vertices_m, faces, facade_area, group, config=config)
         counted = areas * (planes.weight.sum(axis=1) + planes.residual)[:, None]
         facades = tuple(
@@ -246,7 +254,6 @@ def measure_semantic_mesh(
             for k, (az, off) in enumerate(zip(planes.azimuth_deg, planes.offset_m)))
         ungrouped = float((areas[:, facade_classes].sum(axis=1) * planes.residual).sum())
     else:
-        group = group_facade_faces(vertices_m, faces, labels, config=config)
         counted = areas if config.count == "all" else areas[group >= 0]
         facades = tuple(_facade_figures(i, vertices_m, faces, areas, group == i)
                         for i in range(int(group.max()) + 1))
