@@ -70,7 +70,7 @@ def project_onto_facade_planes(
     az_off: list[tuple[float, float]] = []
     if group.max() >= 0 and len(idx):
         az_off = [azimuth_offset(normal[group == k], centroid_xy[group == k],
-                                  facade_area_m2[group == k]) for k in range(group.max() + 1)]
+                                   facade_area_m2[group == k]) for k in range(group.max() + 1)]
         az = np.radians([a for a, _ in az_off])
         plane_n = np.stack([np.cos(az), np.sin(az)], axis=1)  # (K, 2)
         facing = normal[idx, :2] @ plane_n.T  # (I, K) n.N
