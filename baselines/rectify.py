@@ -17,7 +17,8 @@ import numpy as np
 import torch
 from kornia.geometry.transform import get_perspective_transform, warp_perspective
 
-from dataset.classes import FACADE_CLASSES, SemanticClass
+from dataset.classes import SemanticClass
+from dataset.wwr import wwr_from_areas
 
 OUTSIDE = 255  # label of rectified-canvas pixels outside the facade rectangle
 
@@ -118,10 +119,9 @@ def rectified_wwr(rectified: np.ndarray) -> np.ndarray:
     r = np.asarray(rectified)
     if r.ndim != 3:
         raise ValueError(f"rectified labels must be (B, h, w), got {r.shape}")
-    window = (r == SemanticClass.WINDOW).sum(axis=(1, 2))
-    facade = np.isin(r, [int(c) for c in FACADE_CLASSES]).sum(axis=(1, 2))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(facade > 0, window / np.maximum(facade, 1), np.nan)
+    window, wall, door = ((r == c).sum(axis=(1, 2)) for c in
+                          (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
+    return wwr_from_areas(window, wall, door)
 
 
 def _rectangle_corners(sizes: np.ndarray) -> np.ndarray:

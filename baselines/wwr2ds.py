@@ -30,6 +30,7 @@ from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_n
 from dataset.classes import SemanticClass
 from dataset.results import FacadeEstimate, MethodResult
 from dataset.scene import Scene
+from dataset.wwr import wwr_from_areas
 
 METHOD = "2D-S"
 
@@ -89,6 +90,7 @@ def measure_view_2ds(view: FacadeView, config: Wwr2dsConfig) -> tuple[ViewPixels
         if not mask.any():
             raise ViewError("no facade pixels (wall, window or door) in the semantic mask")
     window_px = int(np.count_nonzero(mask & (labels == SemanticClass.WINDOW)))
+    door_px = int(np.count_nonzero(mask & (labels == SemanticClass.DOOR)))
     facade_px = int(np.count_nonzero(mask))
     pixel_area, warning = None, None
     if view.depth_z_m is not None:
@@ -99,7 +101,8 @@ def measure_view_2ds(view: FacadeView, config: Wwr2dsConfig) -> tuple[ViewPixels
             pixel_area = float(np.median(d)) ** 2 / (k.fx * k.fy)
         else:
             warning = f"{view.name}: no valid depth on the facade, so no area scale"
-    return ViewPixels2ds(window_px / facade_px, window_px, facade_px, pixel_area, mask), warning
+    wwr = wwr_from_areas(window_px, facade_px - window_px - door_px, door_px)
+    return ViewPixels2ds(wwr, window_px, facade_px, pixel_area, mask), warning
 
 
 def run_2ds(scene: Scene, protocol: Protocol, config: Wwr2dsConfig = Wwr2dsConfig(), *,

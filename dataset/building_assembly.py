@@ -17,7 +17,7 @@ from dataset.facade_geometry import WallSpec, wall_faces
 from dataset.footprint import polygon_to_geojson
 from dataset.polygon_mesh import PlanarFace, triangulate_faces
 from dataset.truth import Building, BuildingTruth, BuildingType, FacadeTruth
-from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+from dataset.wwr import gross_facade_area_m2, wwr_from_areas
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,7 @@ def facade_truths(
                 wall_area_m2=float(wall),
                 door_area_m2=float(door),
                 facade_area_m2=gross,
-                wwr=window_to_wall_ratio(window, gross),
+                wwr=wwr_from_areas(window, wall, door),
                 curved=fid in curved_facade_ids,
             )
         )
@@ -122,7 +122,7 @@ def assemble_building(
         facade_area_m2=gross,
         wall_area_m2=float(wall),
         door_area_m2=float(door),
-        wwr=window_to_wall_ratio(window, gross),
+        wwr=wwr_from_areas(window, wall, door),
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,

@@ -18,6 +18,7 @@ from dataset.building_assembly import assemble_building, facade_truths
 from dataset.facade_geometry import Opening, WallSpec, drop_near, window_grid
 from dataset.prism import ground_face, overhang_roof_faces, parapet_roof_faces, prism_walls
 from dataset.truth import Building, BuildingType
+from dataset.wwr import wwr_from_areas
 
 RoofKind = Literal["parapet", "overhang"]
 
@@ -116,8 +117,8 @@ def grid_prism_walls(
 def grid_prism_wwr(walls: list[WallSpec]) -> float:
     """Whole-building WWR of walls from their parameters (cheap: no mesh)."""
     facades = facade_truths(walls)
-    window = sum(f.window_area_m2 for f in facades)
-    return window / sum(f.facade_area_m2 for f in facades)
+    return wwr_from_areas(*(sum(getattr(f, f"{c}_area_m2") for f in facades)
+                            for c in ("window", "wall", "door")))
 
 
 def grid_prism_building(

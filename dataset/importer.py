@@ -24,7 +24,7 @@ from dataset.mesh_files import UpAxis, read_labelled_mesh_file
 from dataset.section import cross_section_footprint
 from dataset.truth import Building, BuildingTruth, FacadeTruth, write_building
 from dataset.visibility import embree_intersector, escape_fractions
-from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+from dataset.wwr import gross_facade_area_m2, wwr_from_areas
 
 CURVED_SPREAD_DEG = 1.0  # a facade whose face normals spread wider than this is curved
 
@@ -164,7 +164,7 @@ def import_labelled_mesh(
         facade_area_m2=gross,
         wall_area_m2=wall,
         door_area_m2=door,
-        wwr=window_to_wall_ratio(window, gross),
+        wwr=wwr_from_areas(window, wall, door),
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,
@@ -250,7 +250,7 @@ def _facade_truth(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross,
-        wwr=window_to_wall_ratio(window, gross),
+        wwr=wwr_from_areas(window, wall, door),
         curved=curved,
     )
 

@@ -3,7 +3,7 @@
 Areas follow one convention everywhere: a window's (or door's) area is its
 opening in the facade plane; the reveal (the shallow recess around it) is not
 facade area. Gross facade area = wall + window + door; WWR comes from
-:func:`metrics.wwr.window_to_wall_ratio`, the project's one definition.
+:func:`dataset.wwr.wwr_from_areas`, the project's one definition.
 """
 
 from __future__ import annotations

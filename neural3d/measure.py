@@ -54,7 +54,7 @@ from scipy.ndimage import gaussian_filter1d
 
 from dataset.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
 from dataset.mesh import triangle_areas_m2
-from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+from dataset.wwr import gross_facade_area_m2, wwr_from_areas
 from neural3d.facade_planes import (
     azimuth_offset,
     circular_mean_deg,
@@ -265,7 +265,7 @@ def measure_semantic_mesh(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross_facade_area_m2(wall, window, door),
-        wwr=_wwr_or_none(window, wall, door),
+        wwr=wwr_from_areas(window, wall, door),
         facades=facades,
         ungrouped_facade_area_m2=ungrouped,
     )
@@ -296,7 +296,7 @@ def _facade_figures(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross,
-        wwr=_wwr_or_none(window, wall, door),
+        wwr=wwr_from_areas(window, wall, door),
         width_m=gross / height if height > 0 else 0.0,
         height_m=height,
         face_count=int(mask.sum()),
@@ -320,11 +320,6 @@ def _azimuth_peaks_deg(azimuth_deg: np.ndarray, weight: np.ndarray,
         peaks.append(centres[i])
         hist[np.abs(wrap_deg(centres - centres[i])) < config.min_facade_separation_deg] = 0.0
     return np.array(peaks)
-
-
-def _wwr_or_none(window: float, wall: float, door: float) -> float | None:
-    gross = gross_facade_area_m2(wall, window, door)
-    return window_to_wall_ratio(window, gross) if gross > 0 else None
 
 
 def _check_inputs(vertices_m, faces, vertex_labels) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

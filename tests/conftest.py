@@ -29,7 +29,7 @@ from dataset.generate import GenerateConfig, generate_preset
 from dataset.mesh import LabelledMesh, concatenate_meshes
 from dataset.scene import read_scene
 from dataset.truth import Building, BuildingTruth, FacadeTruth
-from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
+from dataset.wwr import gross_facade_area_m2, wwr_from_areas
 
 BOX_SIZE_M = (20.0, 12.0, 9.0)
 BOX_FLOORS = 3
@@ -97,7 +97,7 @@ def make_box_building() -> Building:
         facades.append(FacadeTruth(
             id=i + 1, normal=tuple(float(x) for x in normal), width_m=width, height_m=height,
             window_area_m2=window, wall_area_m2=wall, door_area_m2=door, facade_area_m2=gross,
-            wwr=window_to_wall_ratio(window, gross),
+            wwr=wwr_from_areas(window, wall, door),
         ))
     x_axis, y_axis = np.array([1.0, 0, 0]), np.array([0, 1.0, 0])
     roof_corner = corners[0] + height * up
@@ -114,7 +114,7 @@ def make_box_building() -> Building:
     truth = BuildingTruth(
         id="box", type="imported", floors=BOX_FLOORS, height_m=height, window_area_m2=window,
         facade_area_m2=gross, wall_area_m2=wall, door_area_m2=door,
-        wwr=window_to_wall_ratio(window, gross), footprint=polygon_to_geojson(footprint),
+        wwr=wwr_from_areas(window, wall, door), footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area), facades=tuple(facades), name="test box",
     )
     return Building(mesh=mesh, truth=truth)

@@ -29,7 +29,6 @@ from dataset.images import (
 from dataset.mesh import LabelledMesh, area_by_class_m2, read_labelled_ply, write_labelled_ply
 from dataset.results import FacadeEstimate, MethodResult, read_result, write_result
 from dataset.scene import Frame, Scene, read_scene, write_transforms
-from metrics.wwr import gross_facade_area_m2, window_to_wall_ratio
 
 
 def test_project_unproject_round_trip():
@@ -131,13 +130,7 @@ def test_read_scene_without_transforms_says_how_to_make_one(tmp_path):
         read_scene(tmp_path)
 
 
-def test_wwr_definition():
-    assert gross_facade_area_m2(6.0, 3.0, 1.0) == 10.0
-    assert window_to_wall_ratio(3.0, 10.0) == pytest.approx(0.3)
-    with pytest.raises(ValueError):
-        window_to_wall_ratio(1.0, 0.0)
-    with pytest.raises(ValueError):
-        window_to_wall_ratio(11.0, 10.0)
+def test_class_names():
     assert class_id_from_name("Window") == SemanticClass.WINDOW
     with pytest.raises(ValueError, match="unknown semantic class"):
         class_id_from_name("glass")

@@ -9,8 +9,8 @@ from sdf_shapes import banded_labels, cylinder_sdf
 from dataset.presets import build_building, preset_recipes
 from dataset.results import FacadeEstimate
 from dataset.truth import FacadeTruth
+from dataset.wwr import wwr_from_areas
 from metrics.facade_match import distance_to_outline_m, has_facade_geometry, match_facades
-from metrics.wwr import window_to_wall_ratio
 from neural3d.extract import facade_estimates
 from neural3d.measure import measure_semantic_mesh
 from neural3d.meshing import extract_mesh, label_vertices
@@ -62,7 +62,7 @@ def test_segments_merge_and_a_stray_estimate_is_left_out(l_shaped):
     merged = match.facades[0]
     assert (merged.id, merged.missing) == (1, False)
     assert (merged.window_area_m2, merged.facade_area_m2) == (6.0, 40.0)
-    assert merged.wwr == pytest.approx(window_to_wall_ratio(6.0, 40.0), abs=TOL)
+    assert merged.wwr == pytest.approx(wwr_from_areas(6.0, 34.0, 0.0), abs=TOL)
     assert (merged.width_m, merged.height_m) == (4.0, 5.0)
     assert merged.centre_m == pytest.approx((1.5, -6.775, 5.0), abs=TOL)  # area-weighted
     assert match.left_out == ((3, "estimated facade 3 faces no truth facade "

@@ -1,0 +1,43 @@
+"""The project's one WWR definition (dataset.wwr): window / (wall + window + door)."""
+
+import numpy as np
+import pytest
+
+from dataset.wwr import gross_facade_area_m2, wwr_from_areas
+
+
+def test_gross_facade_area_is_wall_plus_window_plus_door():
+    assert gross_facade_area_m2(30.0, 10.0, 2.0) == 42.0
+    assert gross_facade_area_m2(0.0, 0.0, 0.0) == 0.0
+
+
+def test_wwr_closed_form_doors_count_in_the_denominator():
+    # A 10 m x 3 m facade with two 1.5 m x 1.2 m windows and a 2 m² door: 3.6 / 30 = 0.12.
+    window = 2 * 1.5 * 1.2
+    assert wwr_from_areas(window, 30.0 - window - 2.0, 2.0) == pytest.approx(0.12, abs=1e-15)
+    # Without the door in the denominator it would be 3.6 / 28.
+    assert wwr_from_areas(3.6, 24.4, 2.0) != pytest.approx(3.6 / 28.0)
+
+
+def test_wwr_no_window_no_facade_all_window():
+    assert wwr_from_areas(0.0, 5.0, 0.0) == 0.0
+    assert wwr_from_areas(5.0, 0.0, 0.0) == 1.0
+    assert wwr_from_areas(0.0, 0.0, 0.0) is None  # no facade: no WWR
+    assert wwr_from_areas(0.0, 0.0, 1.0) == 0.0  # a door alone is facade without window
+
+
+def test_wwr_of_arrays_broadcasts_with_nan_where_no_facade():
+    out = wwr_from_areas(np.array([1, 0, 2]), np.array([3, 0, 0]), 0)
+    np.testing.assert_array_equal(out, [0.25, np.nan, 1.0])
+
+
+@pytest.mark.parametrize("areas", [(-1.0, 2.0, 0.0), (1.0, -2.0, 0.0), (1.0, 2.0, np.nan),
+                                   (np.inf, 1.0, 0.0)])
+def test_wwr_bad_input(areas):
+    with pytest.raises(ValueError, match="must be finite and >= 0"):
+        wwr_from_areas(*areas)
+
+
+def test_gross_area_rejects_negative_parts():
+    with pytest.raises(ValueError, match="door area must be >= 0"):
+        gross_facade_area_m2(1.0, 1.0, -0.5)
