@@ -4,8 +4,9 @@ One scene folder per building, named by the building id, written by
 :func:`dataset.scene_writer.generate_scene` (atomically: a folder with the
 final name is always finished). This module runs a whole preset (optionally
 in several processes, one building each) or a user's mesh, and is the CLI.
-A rerun skips finished scenes made with the same config and seed, so an
-interrupted run resumes where it stopped.
+A rerun skips finished scenes whose provenance record (config, seed, inputs,
+code) matches, so an interrupted run resumes where it stopped, and a scene made
+by older code is re-rendered with the reason logged.
 """
 
 from __future__ import annotations
@@ -15,18 +16,22 @@ import shutil
 import signal
 import sys
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from tqdm import tqdm
 
+from dataset.provenance import file_fingerprint
 from dataset.scene_writer import (
     GenerateConfig,
     PlannedView,
     depth_unit_for,
     generate_scene,
+    only_code_changed,
     plan_views,
+    scene_changes,
     scene_is_finished,
 )
 from dataset.worker_pool import worker_pool
@@ -51,11 +56,13 @@ def scene_seed(base_seed: int, recipe_seed: int) -> int:
 
 def generate_preset(
     name: str, out_root: str | Path, config: GenerateConfig, *, workers: int = 1, seed: int = 0,
-    overwrite: bool = False, progress: bool = True,
+    overwrite: bool = False, progress: bool = True, log: Callable[[str], None] = tqdm.write,
 ) -> list[Path]:
     """Generate every building of preset ``name`` into ``out_root``; return the scene folders.
 
-    Resumable: scenes already finished with this config and seed are skipped.
+    Resumable: scenes whose provenance record matches what this code would write
+    (config, seed, recipe, dataset code, libraries) are skipped; a scene that
+    differs only by the code that made it is re-rendered, with the reason logged.
     ``workers`` processes each build and render one building at a time (a single
     building left to do has its frames split over them instead).
 
@@ -63,7 +70,8 @@ def generate_preset(
     ------
     ValueError
         Unknown preset, ``workers < 1``, unwritable ``out_root``, a scene folder
-        made with another config or seed (pass ``overwrite=True`` to replace it),
+        made with another config, seed or recipe, or by code too old to say
+        (pass ``overwrite=True`` to replace it),
         or a building that cannot be framed.
     """
     from dataset.presets import preset_recipes
@@ -78,14 +86,12 @@ def generate_preset(
         s = scene_seed(seed, recipe.seed)
         scene_dir = out_root / recipe.id
         _remove_stale_partials(out_root, recipe.id)
-        if scene_is_finished(scene_dir, config, s):
+        inputs = {"preset": name, "recipe": recipe.id}
+        changes = scene_changes(scene_dir, config, s, inputs)
+        if not changes:
             continue
-        if scene_dir.exists() and not overwrite:
-            raise ValueError(
-                f"{scene_dir} holds a scene made with another config or seed; use a new --out "
-                "or --overwrite to replace it"
-            )
-        todo.append((recipe, out_root, config, s))
+        _check_replaceable(scene_dir, changes, overwrite, log)
+        todo.append((recipe, out_root, config, s, inputs))
     bar = tqdm(total=len(recipes), initial=len(recipes) - len(todo), desc=f"preset {name}",
                unit="building", disable=not progress)
     with bar:
@@ -114,10 +120,25 @@ def check_writable(folder: Path) -> None:
 def _generate_recipe(job: tuple, progress: bool = False, workers: int = 1) -> Path:
     from dataset.presets import build_building
 
-    recipe, out_root, config, s = job
+    recipe, out_root, config, s, inputs = job
     building = build_building(recipe)
     return generate_scene(building, out_root, config, seed=s, name=recipe.id, progress=progress,
-                          workers=workers)
+                          workers=workers, inputs=inputs)
+
+
+def _check_replaceable(
+    scene_dir: Path, changes: list, overwrite: bool, log: Callable[[str], None]
+) -> None:
+    """Allow re-rendering ``scene_dir`` when it is absent, differs only by the code that made
+    it (logged), or ``overwrite`` is set; otherwise raise ``ValueError`` saying why."""
+    if not scene_dir.exists():
+        return
+    why = "; ".join(str(c) for c in changes)
+    if overwrite or only_code_changed(changes):
+        log(f"{scene_dir.name}: {why}; re-rendering")
+        return
+    raise ValueError(f"{scene_dir} holds another scene ({why}); use a new --out or "
+                     "--overwrite to replace it")
 
 
 def _run_pool(todo: list[tuple], workers: int, bar: tqdm) -> None:
@@ -226,13 +247,13 @@ def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
     name = building.truth.id
     _remove_stale_partials(args.out, name)
     scene_dir = args.out / name
-    if scene_is_finished(scene_dir, config, args.seed):
+    inputs = {"mesh": file_fingerprint(args.mesh)}
+    changes = scene_changes(scene_dir, config, args.seed, inputs)
+    if not changes:
         return scene_dir
-    if scene_dir.exists() and not args.overwrite:
-        raise ValueError(f"{scene_dir} holds a scene made with another config or seed; use a "
-                         "new --out or --overwrite to replace it")
+    _check_replaceable(scene_dir, changes, args.overwrite, tqdm.write)
     return generate_scene(building, args.out, config, seed=args.seed, progress=not args.quiet,
-                          workers=args.workers)
+                          workers=args.workers, inputs=inputs)
 
 
 if __name__ == "__main__":

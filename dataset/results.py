@@ -7,13 +7,15 @@ only these and the scenes' ground truth.
 from __future__ import annotations
 
 import json
-import subprocess
 from dataclasses import asdict, dataclass, field
-from functools import cache
 from pathlib import Path
 from typing import Any
 
 from dataset.atomic import write_json_atomic
+from dataset.provenance import Provenance, code_version
+
+__all__ = ["FacadeEstimate", "MethodResult", "code_version", "read_result", "result_filename",
+           "write_result"]
 
 RESULT_SCHEMA_VERSION = 1
 
@@ -57,6 +59,11 @@ class MethodResult:
     ``code_version`` the git commit (or package version) that produced it.
     ``config`` is kept as it reads back from JSON (tuples become lists), so a
     result equals itself after a write and a read.
+
+    ``provenance`` is the record the comparison keys its cache by
+    (:mod:`dataset.provenance`); ``steps`` the training/optimisation steps a
+    method with a step budget ran (``None`` for the others); ``cut_short`` is
+    true when a safety limit (a wall-clock cap) stopped it before its budget.
     """
 
     scene: str
@@ -71,6 +78,9 @@ class MethodResult:
     code_version: str = ""
     wall_time_s: float = 0.0
     warnings: tuple[str, ...] = ()
+    steps: int | None = None
+    cut_short: bool = False
+    provenance: Provenance | None = None
     schema_version: int = RESULT_SCHEMA_VERSION
 
     def __post_init__(self) -> None:
@@ -84,11 +94,13 @@ class MethodResult:
 
     @staticmethod
     def from_json_dict(d: dict[str, Any]) -> MethodResult:
+        record = d.get("provenance")
         return MethodResult(
             **{
                 **d,
                 "facades": tuple(FacadeEstimate.from_json_dict(f) for f in d.get("facades", ())),
                 "warnings": tuple(d.get("warnings", ())),
+                "provenance": None if record is None else Provenance.from_json_dict(record),
             }
         )
 
@@ -118,24 +130,5 @@ def read_result(path: str | Path) -> MethodResult:
         return MethodResult.from_json_dict(json.loads(path.read_text()))
     except FileNotFoundError as exc:
         raise ValueError(f"result file {path} does not exist") from exc
-    except (json.JSONDecodeError, TypeError, KeyError, UnicodeDecodeError) as exc:
+    except (ValueError, TypeError, KeyError) as exc:  # JSON and Unicode errors are ValueErrors
         raise ValueError(f"{path} is not a valid result file: {exc}") from exc
-
-
-@cache
-def code_version() -> str:
-    """The git commit of the code (with ``-dirty`` for local changes), or the package version."""
-    here = Path(__file__).resolve().parent.parent
-    try:
-        out = subprocess.run(
-            ["git", "describe", "--always", "--dirty", "--abbrev=12"],
-            cwd=here, capture_output=True, text=True, timeout=5, check=True,
-        )
-        return out.stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        from importlib.metadata import PackageNotFoundError, version
-
-        try:
-            return "envelope-bench " + version("envelope-bench")
-        except PackageNotFoundError:
-            return "unknown"

@@ -38,13 +38,22 @@ from dataset.images import (
     write_rgb,
 )
 from dataset.mesh import write_labelled_ply
+from dataset.provenance import (
+    Provenance,
+    ProvenanceChange,
+    code_version,
+    make_provenance,
+    provenance_changes,
+)
 from dataset.render import Raycaster, render_view
-from dataset.results import code_version
 from dataset.scene import Frame, Scene, Split, write_transforms
 from dataset.shading import RgbConfig
 from dataset.truth import Building, write_building
 from dataset.worker_pool import worker_pool
 
+SCENE_CODE = ("dataset",)  # a scene depends on the whole dataset package's code
+SCENE_LIBRARIES = ("numpy", "embreex", "trimesh", "scipy", "shapely", "pillow",
+                   "opencv-contrib-python-headless", "mapbox-earcut")
 _POOL_CHUNK = 8  # views per task: few enough for a smooth progress bar, enough to amortise
 
 
@@ -148,12 +157,14 @@ def depth_unit_for(
 def generate_scene(
     building: Building, out_dir: str | Path, config: GenerateConfig, *, seed: int,
     name: str | None = None, progress: bool = True, workers: int = 1,
+    inputs: dict[str, Any] | None = None,
 ) -> Path:
     """Write one complete scene folder ``out_dir / name`` atomically; return its path.
 
     ``name`` defaults to the building id. ``seed`` fixes the cameras and the
     building's look. An existing folder of that name is replaced. ``workers`` > 1
-    renders the frames in that many processes (same files as with one).
+    renders the frames in that many processes (same files as with one). ``inputs``
+    (JSON) says what the building was made from; it goes into the scene's provenance.
 
     Raises
     ------
@@ -183,28 +194,67 @@ def generate_scene(
                 frames = _render_in_pool(building, tmp, k, views, config, seed, unit, workers,
                                          bar)
         scene = Scene(root=tmp, frames=tuple(frames), depth_unit_scale_factor=unit,
-                      extra={"generator": generator_record(config, seed)})
+                      extra={"generator": generator_record(config, seed, inputs)})
         write_transforms(tmp, scene)
         write_building(tmp / "building.json", building.truth)
         write_labelled_ply(tmp / "mesh.ply", building.mesh)
     return scene_dir
 
 
-def generator_record(config: GenerateConfig, seed: int) -> dict[str, Any]:
-    """What ``transforms.json`` records under ``generator``: config, seed, code version."""
-    return {"config": _config_json(config), "seed": int(seed), "code_version": code_version()}
+def generator_record(
+    config: GenerateConfig, seed: int, inputs: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """What ``transforms.json`` records under ``generator``: config, seed, code version and
+    the scene's :class:`~dataset.provenance.Provenance` (``inputs``: what the building was
+    made from, e.g. ``{"preset": "tiny", "recipe": "tiny_l_shaped"}`` or a mesh file's
+    fingerprint; the seed is added)."""
+    record = scene_provenance(config, seed, inputs)
+    return {"config": _config_json(config), "seed": int(seed), "code_version": code_version(),
+            "provenance": record.to_json_dict()}
 
 
-def scene_is_finished(scene_dir: str | Path, config: GenerateConfig, seed: int) -> bool:
-    """Whether ``scene_dir`` is a finished scene made with this config and seed."""
+def scene_provenance(
+    config: GenerateConfig, seed: int, inputs: dict[str, Any] | None = None
+) -> Provenance:
+    """The provenance record the current code writes for a scene."""
+    return make_provenance(_config_json(config), modules=SCENE_CODE,
+                           inputs={**(inputs or {}), "seed": int(seed)},
+                           libraries=SCENE_LIBRARIES)
+
+
+def scene_changes(
+    scene_dir: str | Path, config: GenerateConfig, seed: int,
+    inputs: dict[str, Any] | None = None,
+) -> list[ProvenanceChange]:
+    """Why ``scene_dir`` is not the scene the current code would make; ``[]``: it is.
+
+    A folder without ``transforms.json`` or with an unreadable generator record
+    gives one change of part ``"record"``.
+    """
     tf = Path(scene_dir) / "transforms.json"
     if not tf.is_file():
-        return False
+        return [ProvenanceChange("record", "no scene")]
     try:
-        made = json.loads(tf.read_text()).get("generator", {})
-    except json.JSONDecodeError:
-        return False
-    return made.get("config") == _config_json(config) and made.get("seed") == int(seed)
+        record = json.loads(tf.read_text()).get("generator", {}).get("provenance")
+        stored = None if record is None else Provenance.from_json_dict(record)
+    except (ValueError, AttributeError) as exc:
+        return [ProvenanceChange("record", f"unreadable generator record: {exc}")]
+    return provenance_changes(stored, scene_provenance(config, seed, inputs))
+
+
+def only_code_changed(changes: list[ProvenanceChange]) -> bool:
+    """Whether a scene differs only by the code or libraries that made it (same config, seed
+    and inputs): then re-rendering it in place loses nothing a user chose."""
+    return bool(changes) and all(c.part in ("code", "environment") for c in changes)
+
+
+def scene_is_finished(
+    scene_dir: str | Path, config: GenerateConfig, seed: int,
+    inputs: dict[str, Any] | None = None,
+) -> bool:
+    """Whether ``scene_dir`` is the finished scene this code makes with this config, seed and
+    inputs (its provenance record matches: same config, dataset code, inputs, libraries)."""
+    return not scene_changes(scene_dir, config, seed, inputs)
 
 
 def _render_view(

@@ -54,5 +54,7 @@ def ensure_benchmark(benchmark: DefaultBenchmark) -> Path:
     except ImportError as exc:
         raise ValueError(f"cannot make the default benchmark: {exc}") from exc
     config = GenerateConfig(resolution=benchmark.resolution, views=benchmark.views)
-    generate_preset(benchmark.preset, benchmark.folder, config, workers=benchmark.workers)
+    # The cache folder is ours: a scene made by other code or settings is simply re-rendered.
+    generate_preset(benchmark.preset, benchmark.folder, config, workers=benchmark.workers,
+                    overwrite=True)
     return benchmark.folder

@@ -1,5 +1,6 @@
 """Preset runs and the CLI: tiny fixture, resumable runs, a user's mesh, one-line errors."""
 
+import json
 import sys
 import types
 from dataclasses import replace
@@ -15,8 +16,10 @@ from dataset.generate import (
     GenerateConfig,
     generate_preset,
     main,
+    scene_seed,
 )
 from dataset.scene import read_scene
+from dataset.scene_writer import scene_changes
 from dataset.truth import Building
 
 SMALL = GenerateConfig(resolution=40, views=6)
@@ -69,7 +72,7 @@ def test_preset_run_is_resumable(tmp_path, monkeypatch):
     assert not (tmp_path / ".box_b.x1.partial").exists()
     # Another config never silently mixes into the folder.
     other = replace(SMALL, views=4)
-    with pytest.raises(ValueError, match="another config or seed"):
+    with pytest.raises(ValueError, match="holds another scene .config changed"):
         generate_preset("boxes", tmp_path, other, progress=False)
     generate_preset("boxes", tmp_path, other, overwrite=True, progress=False)
     assert_complete_scene(tmp_path / "box_a", other)
@@ -150,3 +153,19 @@ def test_cli_help_explains_the_options(capsys):
     for option in ("--preset", "--mesh", "--out", "--resolution", "--views", "--workers",
                    "--seed", "resume"):
         assert option in text
+
+
+def test_scene_made_by_other_code_is_rerendered_with_the_reason(tmp_path, monkeypatch):
+    calls: list = []
+    _fake_presets(monkeypatch, calls)
+    generate_preset("boxes", tmp_path, SMALL, progress=False)
+    tf = tmp_path / "box_a" / "transforms.json"
+    meta = json.loads(tf.read_text())
+    meta["generator"]["provenance"]["code"]["dataset"] = "0" * 16  # as if older code made it
+    tf.write_text(json.dumps(meta))
+    logged: list[str] = []
+    generate_preset("boxes", tmp_path, SMALL, progress=False, log=logged.append)
+    assert calls == ["box_a", "box_b", "box_a"]  # only the stale scene is rendered again
+    assert logged == ["box_a: code of dataset changed; re-rendering"]
+    assert scene_changes(tmp_path / "box_a", SMALL, scene_seed(0, 1),
+                         {"preset": "boxes", "recipe": "box_a"}) == []
