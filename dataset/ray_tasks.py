@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 WAIT_S = 0.5  # longest a wait for results blocks, so that Ctrl-C is seen promptly
+LOCAL_ONLY_ENV = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"  # read once, when ray is first imported
 LOCAL_OBJECT_STORE_MB = 512  # a Ray started here: the scenes in flight, not 30 % of the RAM
 
 
@@ -81,6 +82,10 @@ def ray_session(config: RayConfig) -> Iterator[None]:
     """
     # No usage reports and no dashboard: a Ray started here needs nothing beyond loopback.
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+    if config.address is None:
+        # Ray's switch for a one-machine Ray (as on macOS): node address 127.0.0.1 and every
+        # server bound to loopback, instead of the address of the network interface.
+        os.environ.setdefault(LOCAL_ONLY_ENV, "0")
     try:
         import ray
     except ImportError as exc:
