@@ -6,6 +6,8 @@ Faults are injected by methods made here: they record each attempt as a line in 
 (the test machine shares its disk with the local Ray's workers, which a cluster need not).
 """
 
+import contextlib
+import io
 import os
 import shutil
 import signal
@@ -18,7 +20,7 @@ import pytest
 
 from dataset.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
 from dataset.results import read_result
-from metrics.compare import compare
+from metrics.compare import main
 from metrics.executors import make_executor
 from metrics.methods import method_specs
 from metrics.runner import MethodSpec, find_scenes, run_missing
@@ -78,15 +80,15 @@ def _csv_body(path: Path) -> str:
 def test_2d_methods_give_the_same_tables_with_ray_and_local(local_ray, tiny_benchmark, tmp_path):
     tables = {}
     for name in ("local", "ray"):
-        specs = method_specs(("2D-S", "2D-SS"), ("ideal", "multi"), tmp_path / f"results-{name}")
-        comparison = compare(tiny_benchmark, specs, tmp_path / f"results-{name}",
-                             tmp_path / f"out-{name}", command="test",
-                             execute=make_executor(name, CONFIG))
-        assert {o.status for o in comparison.outcomes} == {"ran"}
-        tables[name] = {f: _csv_body(tmp_path / f"out-{name}" / f)
+        results, out = tmp_path / f"results-{name}", tmp_path / f"out-{name}"
+        with contextlib.redirect_stdout(io.StringIO()):
+            code = main(["--data", str(tiny_benchmark), "--methods", "2D-S,2D-SS",
+                         "--results", str(results), "--out", str(out), "--executor", name])
+        assert code == 0
+        tables[name] = {f: _csv_body(out / f)
                         for f in ("table2_errors.csv", "table3_footprint_iou.csv")}
-        results = sorted((tmp_path / f"results-{name}").glob("*.json"))
-        tables[name]["results"] = [replace(read_result(p), wall_time_s=0.0) for p in results]
+        tables[name]["results"] = [replace(read_result(p), wall_time_s=0.0)
+                                   for p in sorted(results.glob("*.json"))]
     assert len(tables["local"]["results"]) == 3 * 2 * 2
     assert tables["ray"] == tables["local"]  # CSV bodies byte for byte, every result field
 
