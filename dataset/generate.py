@@ -24,6 +24,7 @@ import numpy as np
 from tqdm import tqdm
 
 from dataset.provenance import file_fingerprint
+from dataset.ray_tasks import RayConfig
 from dataset.scene_writer import (
     GenerateConfig,
     PlannedView,
@@ -56,7 +57,8 @@ def scene_seed(base_seed: int, recipe_seed: int) -> int:
 
 def generate_preset(
     name: str, out_root: str | Path, config: GenerateConfig, *, workers: int = 1, seed: int = 0,
-    overwrite: bool = False, progress: bool = True, log: Callable[[str], None] = tqdm.write,
+    overwrite: bool = False, progress: bool = True, ray: RayConfig | None = None,
+    log: Callable[[str], None] = tqdm.write,
 ) -> list[Path]:
     """Generate every building of preset ``name`` into ``out_root``; return the scene folders.
 
@@ -64,7 +66,8 @@ def generate_preset(
     (config, seed, recipe, dataset code, libraries) are skipped; a scene that
     differs only by the code that made it is re-rendered, with the reason logged.
     ``workers`` processes each build and render one building at a time (a single
-    building left to do has its frames split over them instead).
+    building left to do has its frames split over them instead). With ``ray``
+    each building is a task on that Ray cluster instead (:mod:`dataset.ray_generate`).
 
     Raises
     ------
@@ -95,7 +98,13 @@ def generate_preset(
     bar = tqdm(total=len(recipes), initial=len(recipes) - len(todo), desc=f"preset {name}",
                unit="building", disable=not progress)
     with bar:
-        if workers == 1 or len(todo) <= 1:
+        if ray is not None:
+            from dataset.ray_generate import generate_on_ray
+
+            for _ in generate_on_ray([j[0] for j in todo], out_root, config,
+                                     [j[3] for j in todo], [j[4] for j in todo], ray):
+                bar.update()
+        elif workers == 1 or len(todo) <= 1:
             for job in todo:
                 # A lone building still uses the workers: its frames are split over them.
                 _generate_recipe(job, progress=progress, workers=workers)
@@ -199,6 +208,12 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--workers", type=int, default=1,
                    help="processes: with --preset each renders one building at a time; with "
                         "--mesh they share the building's frames (default 1)")
+    p.add_argument("--executor", choices=("local", "ray"), default="local",
+                   help="with --preset: local (--workers processes here, the default) or ray "
+                        "(one Ray task per building; docs/cluster.md)")
+    p.add_argument("--ray-address", metavar="ADDR",
+                   help="with --executor ray: a running cluster (HOST:PORT printed by "
+                        "`ray start --head`, or auto); default: start Ray on this machine")
     p.add_argument("--seed", type=int, default=0, help="seed for cameras and looks (default 0)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")
@@ -216,10 +231,14 @@ def main(argv: list[str] | None = None) -> int:
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
             fov_deg=args.fov, supersampling=args.supersampling,
         )
+        if args.executor == "ray" and args.preset is None:
+            raise ValueError("--executor ray renders a preset's buildings as tasks; with --mesh "
+                             "use --workers to split one building's frames over processes")
         if args.preset is not None:
+            ray = RayConfig(address=args.ray_address) if args.executor == "ray" else None
             scenes = generate_preset(args.preset, args.out, config, workers=args.workers,
                                      seed=args.seed, overwrite=args.overwrite,
-                                     progress=not args.quiet)
+                                     progress=not args.quiet, ray=ray)
         else:
             scenes = [_generate_mesh(args, config)]
     except ValueError as exc:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from dataset.device import resolve_device
+from dataset.ray_tasks import RayConfig
 from dataset.results import code_version
 from dataset.truth import BuildingTruth, read_building
 from metrics.aggregate import aggregate_by_family
@@ -34,6 +35,7 @@ from metrics.errors import (
     facade_errors,
 )
 from metrics.errors import failed_building as failed_row
+from metrics.executors import EXECUTORS, make_executor
 from metrics.methods import (
     METHODS,
     VIEW_PROTOCOLS,
@@ -50,7 +52,7 @@ from metrics.report import (
     table2_errors,
     table3_footprint_iou,
 )
-from metrics.runner import MethodSpec, Outcome, find_scenes, run_missing
+from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
 
 PROVENANCE_FILE = "provenance.json"
@@ -79,8 +81,10 @@ def compare(
     *,
     allow_run: bool = True,
     command: str = "python -m metrics.compare",
+    execute: Execute = execute_local,
 ) -> Comparison:
-    """Run what is missing, evaluate every result against the truth and write all outputs.
+    """Run what is missing (with ``execute``), evaluate every result against the truth and
+    write all outputs.
 
     Raises
     ------
@@ -88,7 +92,7 @@ def compare(
         If ``data`` holds no scene folder.
     """
     scene_dirs = find_scenes(data)
-    outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run)
+    outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run, execute=execute)
     truths = {d.name: _read_truth(d) for d in scene_dirs}
     rows, facade_rows = evaluate(outcomes, truths)
     groups = aggregate_by_family(rows)
@@ -277,6 +281,13 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         help="torch device for neural3d: cpu or cuda (default: cpu)")
     parser.add_argument("--no-run", action="store_true",
                         help="only read existing result files; never run a method")
+    parser.add_argument("--executor", default="local", choices=EXECUTORS,
+                        help="where missing runs execute: local (one after the other in this "
+                        "process, the default) or ray (one Ray task per building, method and "
+                        "views, on a Ray started here or on --ray-address; docs/cluster.md)")
+    parser.add_argument("--ray-address", metavar="ADDR",
+                        help="with --executor ray: a running cluster (HOST:PORT as printed by "
+                        "`ray start --head`, or auto); default: start Ray on this machine")
     return parser.parse_args(argv)
 
 
@@ -286,7 +297,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         start = time.perf_counter()
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         views = tuple(v.strip() for v in args.views.split(",") if v.strip())
-        resolve_device(args.device)
+        if args.executor == "local" or not args.device.startswith("cuda"):
+            resolve_device(args.device)  # a Ray cluster's GPUs are on its nodes, not here
+        execute = make_executor(args.executor, RayConfig(address=args.ray_address))
         default = DefaultBenchmark() if args.data is None else None
         resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
         budget = Neural3dBudget(
@@ -304,7 +317,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             specs = method_specs(methods, views, results, neural3d=budget)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
         comparison = compare(data, specs, results, out, allow_run=not args.no_run,
-                             command=f"python -m metrics.compare {argv_text}".strip())
+                             command=f"python -m metrics.compare {argv_text}".strip(),
+                             execute=execute)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

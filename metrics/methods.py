@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from dataset.ray_tasks import TaskResources
 from dataset.scene import read_scene
 from metrics.runner import MethodSpec
 
@@ -125,7 +126,7 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
     extract = ExtractConfig() if budget.resolution is None else ExtractConfig(
         resolution=budget.resolution)
 
-    def run(scene_dir: Path, protocol: str):
+    def run(scene_dir: Path, protocol: str, artefacts_dir: Path = runs_dir):
         import torch
 
         # isort sees a module as first-party only once its file exists: keep this block as is.
@@ -133,14 +134,23 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
         from neural3d.train import train
 
         device = torch.device(budget.device)
-        run_dir = train(scene_dir, train_config, runs_dir, device=device,
+        run_dir = train(scene_dir, train_config, artefacts_dir, device=device,
                         max_seconds=budget.minutes * 60.0)
         result = extract_run(run_dir, config=extract, device=device,
                              out_dir=run_dir / NEURAL3D_EXTRACT_FOLDER)
         return replace(result, config={**result.config, **extra})
 
     requested = {**asdict(extract), **extra}
-    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True)
+    return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True,
+                      resources=neural3d_resources(budget.device), artefacts_dir=runs_dir)
+
+
+def neural3d_resources(device: str) -> TaskResources:
+    """What one neural3d run reserves on a cluster node: a GPU (and a core to feed it) on
+    CUDA; on CPU two cores (torch trains with as many threads as the task has cores)."""
+    if device.startswith("cuda"):
+        return TaskResources(cpus=1.0, gpus=1.0)
+    return TaskResources(cpus=2.0)
 
 
 def read_only_specs(names: tuple[str, ...], views: tuple[str, ...]) -> list[MethodSpec]:

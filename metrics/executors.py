@@ -1,0 +1,89 @@
+"""Where the comparison's missing runs execute: here (``local``) or on a Ray cluster (``ray``).
+
+Both are :data:`metrics.runner.Execute` functions: they take the jobs and the
+function that runs one (:func:`metrics.runner.run_job`) and yield each
+outcome as it finishes; :func:`metrics.runner.run_missing` writes the result
+files. ``ray`` makes one Ray task per (scene, method, protocol) and assumes no
+shared file system: each scene folder is packed once into the object store
+and unpacked by the worker into a temporary folder; the outcome and the
+method's artefacts folder (neural3d's run folder, with ``extract/mesh.ply``
+and ``footprint.geojson``) come back, and this process alone writes them,
+atomically. Each task reserves its spec's ``resources``; a task whose worker
+dies is re-run up to ``RayConfig.max_retries`` times and then recorded as a
+failed run, like a method that fails on its input (which is not re-run).
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Iterator, Sequence
+from dataclasses import replace
+from functools import partial
+from pathlib import Path
+from typing import Literal
+
+from dataset.atomic import atomic_directory
+from dataset.folder_pack import pack_folder, unpack_folder
+from dataset.ray_tasks import RayConfig, TaskLost, ray_session, run_tasks
+from metrics.runner import Execute, Job, Outcome, RunOne, execute_local
+
+ExecutorName = Literal["local", "ray"]
+EXECUTORS: tuple[str, ...] = ("local", "ray")
+
+
+def make_executor(name: ExecutorName, ray: RayConfig | None = None) -> Execute:
+    """The executor called ``name``; ``ray`` says where a ``ray`` executor's tasks run
+    (default: a Ray started on this machine).
+
+    Raises
+    ------
+    ValueError
+        If ``name`` is not an executor.
+    """
+    if name == "local":
+        return execute_local
+    if name == "ray":
+        return partial(execute_ray, config=ray if ray is not None else RayConfig())
+    raise ValueError(f"unknown executor {name!r}; choose from {', '.join(EXECUTORS)}")
+
+
+def execute_ray(
+    jobs: Sequence[Job], run_one: RunOne, *, config: RayConfig
+) -> Iterator[tuple[int, Outcome]]:
+    """Run every job as a Ray task; yield ``(index, outcome)`` as tasks finish.
+
+    A job's artefacts folder is unpacked into ``spec.artefacts_dir / <scene>``
+    (replacing the one there) before its outcome is yielded. Leaving the
+    iteration early (Ctrl-C) cancels the tasks not yet collected.
+    """
+    if not jobs:
+        return
+    with ray_session(config):
+        import ray
+
+        # One object per scene, shared by all of its jobs (the driver's folders are not read
+        # again: a worker never needs them).
+        scenes = {d: ray.put(pack_folder(d)) for d in dict.fromkeys(j.scene_dir for j in jobs)}
+        calls = [((scenes[j.scene_dir], j, run_one), j.spec.resources) for j in jobs]
+        for i, value in run_tasks(_run_packed, calls, max_retries=config.max_retries):
+            job = jobs[i]
+            if isinstance(value, TaskLost):
+                yield i, Outcome(job.scene_dir.name, job.spec.name, job.protocol, "failed",
+                                 reason=f"Ray task lost: {value.reason}")
+                continue
+            outcome, artefacts = value
+            if artefacts is not None and job.spec.artefacts_dir is not None:
+                with atomic_directory(job.spec.artefacts_dir / job.scene_dir.name) as tmp:
+                    unpack_folder(artefacts, tmp)
+            yield i, outcome
+
+
+def _run_packed(scene_tar: bytes, job: Job, run_one: RunOne) -> tuple[Outcome, bytes | None]:
+    """On a worker: unpack the scene into a temporary folder, run the job there, and return
+    its outcome with its artefacts folder packed (``None`` if the method wrote none)."""
+    with tempfile.TemporaryDirectory(prefix="envelope-bench-") as tmp:
+        scene_dir = unpack_folder(scene_tar, Path(tmp) / "scene" / job.scene_dir.name)
+        artefacts = Path(tmp) / "artefacts" if job.spec.artefacts_dir is not None else None
+        outcome = run_one(replace(job, scene_dir=scene_dir, artefacts_dir=artefacts))
+        kept = artefacts / scene_dir.name if artefacts is not None else None
+        return outcome, pack_folder(kept) if kept is not None and kept.is_dir() else None
