@@ -1,7 +1,7 @@
 """The comparison on a local Ray vs here, Ray's cost per task, and a projection to N nodes.
 
     python bench/cluster.py                                   # 2D methods on the tiny preset
-    python bench/cluster.py --methods 2D-S,2D-SS,neural3d --neural3d-minutes 0.2 \\
+    python bench/cluster.py --methods 2D-S,2D-SS,neural3d --neural3d-steps 100 \\
         --out docs/cluster_bench.md
 
 Three measurements, printed as Markdown (and written to ``--out``):
@@ -182,8 +182,8 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--data", type=Path, help="benchmark folder (default: tiny preset, rendered)")
     p.add_argument("--methods", default="2D-S,2D-SS", help="comma-separated (default 2D-S,2D-SS)")
-    p.add_argument("--neural3d-minutes", type=float, default=0.2,
-                   help="neural3d training limit per building, minutes (default 0.2)")
+    p.add_argument("--neural3d-steps", type=int, default=100,
+                   help="neural3d training steps per building (default 100)")
     p.add_argument("--cpus", type=int, default=os.cpu_count(),
                    help="cores of the local Ray (default: all)")
     p.add_argument("--buildings", type=int, default=500, help="buildings of the projected study")
@@ -193,7 +193,7 @@ def main(argv: list[str] | None = None) -> int:
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
     os.environ.setdefault(LOCAL_ONLY_ENV, "0")
     methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
-    budget = Neural3dBudget(preset="tiny", minutes=args.neural3d_minutes, resolution=64,
+    budget = Neural3dBudget(preset="tiny", steps=args.neural3d_steps, resolution=64,
                             eval_frames=1)
 
     def specs_for(results: Path) -> list[MethodSpec]:

@@ -52,6 +52,9 @@ class GroupSummary:
 
     ``buildings`` counts every row of the group, ``failed`` those that gave no
     result; ``reasons`` holds ``"<scene>: <reason>"`` for each failure.
+    ``steps`` is the members' step budget (``"1000"``, a range ``"500–1000"``,
+    or ``None`` for methods without one); ``marks`` counts the members'
+    marks (``"cut short: 1; stale: 3"``, ``""`` for none).
     """
 
     family: str
@@ -64,6 +67,8 @@ class GroupSummary:
     facade_ape: Summary
     footprint_iou: Summary
     reasons: tuple[str, ...] = ()
+    steps: str | None = None
+    marks: str = ""
 
 
 def aggregate_by_family(
@@ -103,7 +108,24 @@ def _summarise_group(
         facade_ape=summarise(r.facade_ape for r in ok),
         footprint_iou=summarise(r.footprint_iou for r in ok),
         reasons=tuple(f"{r.scene}: {r.reason}" for r in members if r.status != "ok"),
+        steps=_steps_text([r.steps for r in members]),
+        marks=_marks_text([r.marks for r in members]),
     )
+
+
+def _steps_text(steps: Sequence[int | None]) -> str | None:
+    known = sorted({s for s in steps if s is not None})
+    if not known:
+        return None
+    return str(known[0]) if len(known) == 1 else f"{known[0]}–{known[-1]}"
+
+
+def _marks_text(marks: Sequence[str]) -> str:
+    counts: dict[str, int] = {}
+    for row in marks:
+        for mark in filter(None, row.split("; ")):
+            counts[mark] = counts.get(mark, 0) + 1
+    return "; ".join(f"{m}: {n}" for m, n in sorted(counts.items()))
 
 
 def family_rank(family: str) -> tuple[int, str]:

@@ -11,7 +11,7 @@ DEFAULT_CACHE = Path(".cache/envelope-bench")
 @dataclass(frozen=True)
 class DefaultBenchmark:
     """The default run's benchmark (preset, image size, views, generator workers) and
-    neural3d's extraction resolution, chosen to fit ~10 minutes on 2 cores.
+    neural3d's step budget and extraction resolution, chosen to fit ~12 minutes on 2 cores.
 
     ``root / preset`` is the benchmark folder (relative to the working folder).
     """
@@ -21,21 +21,22 @@ class DefaultBenchmark:
     resolution: int = 128
     views: int = 40
     workers: int = 2
+    neural3d_steps: int = 1000
     neural3d_resolution: int = 128
     neural3d_eval_frames: int = 1
-    expected_minutes: float = 10.0
+    expected_minutes: float = 12.0
 
     @property
     def folder(self) -> Path:
         return self.root / self.preset
 
-    def announce(self, methods: tuple[str, ...], neural3d_minutes: float) -> str:
+    def announce(self, methods: tuple[str, ...], neural3d_steps: int) -> str:
         """The line printed before the default run starts."""
         made = "cached" if self.folder.is_dir() else "to be generated"
         return (
             f"Built-in default: the '{self.preset}' benchmark ({made} in {self.folder}, "
             f"{self.resolution} px, {self.views} orbit views), methods {', '.join(methods)}"
-            + (f", neural3d {neural3d_minutes:g} min per building" if "neural3d" in methods
+            + (f", neural3d {neural3d_steps} training steps per building" if "neural3d" in methods
                else "")
             + f". This takes up to about {self.expected_minutes:g} minutes on 2 CPU cores."
         )

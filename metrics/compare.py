@@ -16,7 +16,7 @@ import shutil
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -36,6 +36,7 @@ from metrics.errors import (
 )
 from metrics.errors import failed_building as failed_row
 from metrics.executors import EXECUTORS, make_executor
+from metrics.explain import explain, methods_provenance_text, run_timings
 from metrics.methods import (
     METHODS,
     VIEW_PROTOCOLS,
@@ -43,7 +44,6 @@ from metrics.methods import (
     debug_images_2dss,
     method_specs,
     neural3d_extract_dir,
-    read_only_specs,
 )
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report import (
@@ -51,6 +51,7 @@ from metrics.report import (
     per_facade_table,
     table2_errors,
     table3_footprint_iou,
+    timing_table,
 )
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -80,11 +81,17 @@ def compare(
     out_dir: Path,
     *,
     allow_run: bool = True,
+    reuse_stale: bool = False,
     command: str = "python -m metrics.compare",
     execute: Execute = execute_local,
 ) -> Comparison:
-    """Run what is missing (with ``execute``), evaluate every result against the truth and
-    write all outputs.
+    """Run what is missing or stale (with ``execute``), evaluate every result against the
+    truth and write all outputs.
+
+    The tables (CSV, Markdown, LaTeX), per-building and per-facade CSVs are the
+    same bytes on every rerun with the same code, data and settings: their
+    header names the command, code version and budgets, never a time; the run
+    times go to ``timing.csv`` and the moment to ``provenance.json``.
 
     Raises
     ------
@@ -92,28 +99,28 @@ def compare(
         If ``data`` holds no scene folder.
     """
     scene_dirs = find_scenes(data)
-    outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run, execute=execute)
+    outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run,
+                           reuse_stale=reuse_stale, execute=execute)
     truths = {d.name: _read_truth(d) for d in scene_dirs}
     rows, facade_rows = evaluate(outcomes, truths)
     groups = aggregate_by_family(rows)
     footprint_methods = {s.name for s in specs if s.has_footprint}
+    footer = f"made by {methods_provenance_text(specs)}; details in {PROVENANCE_FILE}"
+    table2, table3 = table2_errors(groups), table3_footprint_iou(groups, footprint_methods)
     comparison = Comparison(
         rows=tuple(rows),
         facade_rows=tuple(facade_rows),
-        table2=table2_errors(groups),
-        table3=table3_footprint_iou(groups, footprint_methods),
+        table2=replace(table2, notes=(*table2.notes, footer)),
+        table3=replace(table3, notes=(*table3.notes, footer)),
         outcomes=tuple(outcomes),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
-    comment = (
-        f"produced by `{command}` (envelope-bench {provenance['code_version']}) "
-        f"from {provenance['data']} at {provenance['created_utc']}; "
-        f"methods: {', '.join(s.name for s in specs)}; details in {PROVENANCE_FILE}"
-    )
+    comment = f"produced by `{command}`; {footer}"
     out_dir.mkdir(parents=True, exist_ok=True)
     for table in (comparison.table2, comparison.table3):
         write_table(table, out_dir, comment)
-    for table in (per_building_table(rows), per_facade_table(facade_rows)):
+    for table in (per_building_table(rows), per_facade_table(facade_rows),
+                  timing_table(run_timings(outcomes))):
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
     _write_plots(groups, rows, out_dir / PLOTS_FOLDER)
     _write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
@@ -136,7 +143,7 @@ def evaluate(
         if o.result is None:
             rows.append(failed_row(o.scene, family, o.method, o.protocol, o.reason))
             continue
-        rows.append(building_errors(o.result, truth))
+        rows.append(building_errors(o.result, truth, stale=o.status == "stale"))
         facade_rows.extend(facade_errors(o.result, truth))
     return rows, facade_rows
 
@@ -170,7 +177,11 @@ def _provenance(
                 "status": o.status, "reason": o.reason,
                 "result_file": str(o.path) if o.path else None,
                 "result_code_version": o.result.code_version if o.result else None,
+                "steps": o.result.steps if o.result else None,
+                "cut_short": o.result.cut_short if o.result else None,
                 "wall_time_s": o.result.wall_time_s if o.result else None,
+                "provenance": (o.result.provenance.to_json_dict()
+                               if o.result and o.result.provenance else None),
             }
             for o in outcomes
         ],
@@ -268,9 +279,17 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,
                         help="folder for tables, plots, provenance (default: <data>-compare)")
-    parser.add_argument("--neural3d-minutes", type=float, default=Neural3dBudget.minutes,
-                        help="training time limit per building for neural3d, minutes "
-                        f"(default: {Neural3dBudget.minutes})")
+    parser.add_argument("--neural3d-steps", type=int,
+                        help="training steps per building for neural3d: the budget that fixes "
+                        "its result (default: the preset's own; the built-in default run uses "
+                        f"{DefaultBenchmark.neural3d_steps})")
+    parser.add_argument("--neural3d-max-minutes", type=float, default=Neural3dBudget.max_minutes,
+                        help="safety cap on neural3d's training time per building, minutes; a "
+                        "run it stops is marked 'cut short' in every table "
+                        f"(default: {Neural3dBudget.max_minutes:g})")
+    parser.add_argument("--neural3d-threads", type=int, default=Neural3dBudget.threads,
+                        help="torch CPU threads for neural3d (recorded with the result; "
+                        f"default: {Neural3dBudget.threads})")
     parser.add_argument("--neural3d-preset", default=Neural3dBudget.preset,
                         choices=("paper", "fast", "tiny"), help="neural3d training preset")
     parser.add_argument("--neural3d-resolution", type=int,
@@ -280,7 +299,14 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--device", default="cpu",
                         help="torch device for neural3d: cpu or cuda (default: cpu)")
     parser.add_argument("--no-run", action="store_true",
-                        help="only read existing result files; never run a method")
+                        help="only read existing result files; never run a method (results "
+                        "made by other code or settings are marked stale)")
+    parser.add_argument("--reuse-stale", action="store_true",
+                        help="keep stored results made by other code or settings instead of "
+                        "recomputing them; the tables mark them 'stale'")
+    parser.add_argument("--explain", nargs=2, metavar=("SCENE", "METHOD"),
+                        help="print the full provenance record of one scene's result(s) of one "
+                        "method, and whether the current code would reuse it; runs nothing")
     parser.add_argument("--executor", default="local", choices=EXECUTORS,
                         help="where missing runs execute: local (one after the other in this "
                         "process, the default) or ray (one Ray task per building, method and "
@@ -302,21 +328,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         execute = make_executor(args.executor, RayConfig(address=args.ray_address))
         default = DefaultBenchmark() if args.data is None else None
         resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
+        steps = args.neural3d_steps or (default.neural3d_steps if default else None)
         budget = Neural3dBudget(
-            preset=args.neural3d_preset, minutes=args.neural3d_minutes, resolution=resolution,
+            preset=args.neural3d_preset, steps=steps, max_minutes=args.neural3d_max_minutes,
+            threads=args.neural3d_threads, resolution=resolution,
             eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
         )
+        if args.explain:
+            return _explain(args, default, methods, views, budget)
         if default is not None:
-            print(default.announce(methods, budget.minutes), flush=True)
+            print(default.announce(methods, budget.steps), flush=True)
         data = (ensure_benchmark(default) if default is not None else args.data).resolve()
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
-        if args.no_run:
-            specs = read_only_specs(methods, views)
-        else:
-            specs = method_specs(methods, views, results, neural3d=budget)
+        specs = method_specs(methods, views, results, neural3d=budget)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
         comparison = compare(data, specs, results, out, allow_run=not args.no_run,
+                             reuse_stale=args.reuse_stale,
                              command=f"python -m metrics.compare {argv_text}".strip(),
                              execute=execute)
     except ValueError as exc:
@@ -330,6 +358,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(to_text(comparison.table3))
     print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
           f"(results in {results}); {time.perf_counter() - start:.0f} s")
+    return 0
+
+
+def _explain(args: argparse.Namespace, default: DefaultBenchmark | None,
+             methods: tuple[str, ...], views: tuple[str, ...], budget: Neural3dBudget) -> int:
+    """``--explain SCENE METHOD``: print one scene's result records of one method."""
+    scene, method = args.explain
+    data = (default.folder if default is not None else args.data).resolve()
+    results = args.results or data.with_name(f"{data.name}-results")
+    scene_dir = next((d for d in find_scenes(data) if d.name == scene), None)
+    if scene_dir is None:
+        raise ValueError(f"no scene {scene!r} in {data}")
+    (spec,) = method_specs((method,), views, results, neural3d=budget)
+    print(explain(scene_dir, spec, results))
     return 0
 
 

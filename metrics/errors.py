@@ -9,7 +9,7 @@ Footprints are compared by intersection over union of their polygons.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import shapely
@@ -22,6 +22,8 @@ from dataset.truth import BuildingTruth
 from metrics.facade_match import has_facade_geometry, match_facades
 
 Status = Literal["ok", "failed"]
+CUT_SHORT = "cut short"  # mark: a safety time cap stopped the run before its step budget
+STALE = "stale"  # mark: made by other code or settings, kept with --reuse-stale
 NO_TRUTH_FAMILY = "unknown"  # family of a scene without building.json (a user's photos)
 FACADE_PROTOCOLS = ("ideal", "multi")  # protocols whose facade ids are the truth's ids
 LEFT_OUT_FACADE_ID = 0  # facade id of a row for an estimate that faces no truth facade
@@ -72,6 +74,10 @@ class BuildingErrors:
 
     ``status`` is ``"failed"`` when the method produced no WWR (``reason`` says why);
     error fields are ``None`` where the method or the truth lacks the figure.
+    ``steps`` is the training-step budget a method ran (``None`` for methods
+    without one); ``marks`` lists what a reader must know about the figure
+    (:data:`CUT_SHORT`, :data:`STALE`), joined by ``"; "``. Timing is kept
+    apart (:class:`RunTiming`), so these rows are the same on every rerun.
     """
 
     scene: str
@@ -90,7 +96,20 @@ class BuildingErrors:
     facade_true_m2: float | None = None
     facade_ape: float | None = None
     footprint_iou: float | None = None
-    wall_time_s: float | None = None
+    steps: int | None = None
+    marks: str = ""
+
+
+@dataclass(frozen=True)
+class RunTiming:
+    """How long one (scene, method, protocol) took and whether it ran now or was reused."""
+
+    scene: str
+    method: str
+    protocol: str
+    status: str
+    steps: int | None
+    wall_time_s: float | None
 
 
 @dataclass(frozen=True)
@@ -118,17 +137,27 @@ def failed_building(
     return BuildingErrors(scene, family, method, protocol, status="failed", reason=reason)
 
 
-def building_errors(result: MethodResult, truth: BuildingTruth | None) -> BuildingErrors:
+def result_marks(result: MethodResult, *, stale: bool = False) -> str:
+    """The marks of a result's row: :data:`CUT_SHORT` and/or :data:`STALE`, ``"; "``-joined."""
+    return "; ".join(m for m, on in ((CUT_SHORT, result.cut_short), (STALE, stale)) if on)
+
+
+def building_errors(
+    result: MethodResult, truth: BuildingTruth | None, *, stale: bool = False
+) -> BuildingErrors:
     """Errors of one result against its building's truth (``None``: estimates only).
 
+    ``stale``: the result was kept although made by other code or settings.
     A result without a WWR counts as failed, with its warnings as the reason.
     A footprint that cannot be compared (malformed GeoJSON) gives IoU ``None``
     and a reason, but does not fail the WWR figures.
     """
     family = truth.type if truth is not None else NO_TRUTH_FAMILY
+    marks = result_marks(result, stale=stale)
     if result.wwr is None or not math.isfinite(result.wwr):
         reason = "; ".join(result.warnings) or "the method produced no WWR"
-        return failed_building(result.scene, family, result.method, result.protocol, reason)
+        return replace(failed_building(result.scene, family, result.method, result.protocol,
+                                       reason), steps=result.steps, marks=marks)
     reasons: list[str] = []
     iou = None
     if result.footprint is not None and truth is not None:
@@ -162,7 +191,8 @@ def building_errors(result: MethodResult, truth: BuildingTruth | None) -> Buildi
         facade_true_m2=t.facade_area_m2 if t else None,
         facade_ape=facade_ape,
         footprint_iou=iou,
-        wall_time_s=result.wall_time_s,
+        steps=result.steps,
+        marks=marks,
     )
 
 

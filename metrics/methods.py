@@ -22,23 +22,41 @@ VIEW_PROTOCOLS: tuple[str, ...] = ("ideal", "multi")
 NEURAL3D_PROTOCOL = "train"
 NEURAL3D_RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
 NEURAL3D_EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
+# What the results depend on, for their provenance records (dataset.provenance).
+BASELINE_CODE = ("dataset", "baselines")
+BASELINE_LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless", "scipy",
+                      "scikit-image", "shapely", "pillow")
+NEURAL3D_CODE = ("dataset", "neural3d")
+NEURAL3D_LIBRARIES = ("numpy", "torch", "scipy", "scikit-image", "shapely", "trimesh", "pillow")
 
 
 @dataclass(frozen=True)
 class Neural3dBudget:
-    """How neural3d runs inside a comparison: training preset and time limit per building,
-    eval frames rendered at the end of training and marching-cubes resolution of the
-    extraction (``None``: the preset's / neural3d's own), device."""
+    """How neural3d runs inside a comparison.
+
+    ``steps``: training steps per building (``None``: the preset's own
+    ``iterations``), the budget that fixes the result; ``max_minutes``: a
+    wall-clock safety cap per building (a run it stops is marked cut short);
+    ``threads``: torch CPU threads (recorded, since reductions depend on it);
+    ``resolution``, ``eval_frames``: marching-cubes resolution and eval frames
+    (``None``: neural3d's / the preset's own); ``device``: cpu or cuda.
+    """
 
     preset: Literal["paper", "fast", "tiny"] = "fast"
-    minutes: float = 2.0
+    steps: int | None = None
+    max_minutes: float = 60.0
+    threads: int = 2
     resolution: int | None = None
     eval_frames: int | None = None
     device: str = "cpu"
 
     def __post_init__(self) -> None:
-        if not self.minutes > 0:
-            raise ValueError(f"neural3d minutes must be > 0, got {self.minutes}")
+        if self.steps is not None and self.steps < 1:
+            raise ValueError(f"neural3d steps must be >= 1, got {self.steps}")
+        if not self.max_minutes > 0:
+            raise ValueError(f"neural3d max minutes must be > 0, got {self.max_minutes}")
+        if self.threads < 1:
+            raise ValueError(f"neural3d threads must be >= 1, got {self.threads}")
         if self.resolution is not None and self.resolution < 8:
             raise ValueError(f"neural3d resolution must be >= 8, got {self.resolution}")
         if self.eval_frames is not None and self.eval_frames < 1:
@@ -79,7 +97,8 @@ def spec_2ds(views: tuple[str, ...]) -> MethodSpec:
     def run(scene_dir: Path, protocol: str):
         return run_2ds(read_scene(scene_dir), protocol, config)
 
-    return MethodSpec("2D-S", views, _config_dict(config), run)
+    return MethodSpec("2D-S", views, _config_dict(config), run, code=BASELINE_CODE,
+                      libraries=BASELINE_LIBRARIES)
 
 
 def spec_2dss(views: tuple[str, ...]) -> MethodSpec:
@@ -93,7 +112,8 @@ def spec_2dss(views: tuple[str, ...]) -> MethodSpec:
     def run(scene_dir: Path, protocol: str):
         return run_2dss(read_scene(scene_dir), protocol, config)
 
-    return MethodSpec("2D-SS", views, _config_dict(config), run)
+    return MethodSpec("2D-SS", views, _config_dict(config), run, code=BASELINE_CODE,
+                      libraries=BASELINE_LIBRARIES)
 
 
 def debug_images_2dss(scene_dir: Path, protocol: str, debug_dir: Path) -> None:
@@ -104,23 +124,30 @@ def debug_images_2dss(scene_dir: Path, protocol: str, debug_dir: Path) -> None:
 
 
 def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
-    """neural3d: time-limited training (``neural3d.train``) then extraction (``neural3d.extract``).
+    """neural3d: training for ``budget.steps`` steps (``neural3d.train``) then extraction
+    (``neural3d.extract``).
 
-    The result's config is the whole extraction config
+    The spec's config is the whole extraction config
     (``neural3d.extract_config.ExtractConfig``: resolution, footprint planes,
-    measurement) plus the training config and a ``budget`` entry (preset,
-    seconds), so a result trained, meshed or measured otherwise is recomputed.
+    measurement) plus the training config (its ``iterations`` = the step
+    budget) and a ``budget`` entry (preset, steps, safety cap, threads, device),
+    so a result trained, meshed or measured otherwise is recomputed. The result
+    records the steps trained and whether the time cap cut training short.
     Training (and torch) is imported only when a run is needed.
     """
     from neural3d.config import config_to_dict, preset_config
     from neural3d.extract_config import ExtractConfig
 
     train_config = preset_config(budget.preset)
+    if budget.steps is not None:
+        train_config = replace(train_config, iterations=budget.steps)
     if budget.eval_frames is not None:
         # Rendering the eval frames costs about as much as a minute of CPU training.
         train_config = replace(train_config, eval_max_frames=budget.eval_frames)
     extra = {
-        "budget": {"preset": budget.preset, "max_seconds": budget.minutes * 60.0},
+        "budget": {"preset": budget.preset, "steps": train_config.iterations,
+                   "max_seconds": budget.max_minutes * 60.0, "threads": budget.threads,
+                   "device": budget.device},
         "train": config_to_dict(train_config),
     }
     extract = ExtractConfig() if budget.resolution is None else ExtractConfig(
@@ -129,20 +156,28 @@ def spec_neural3d(runs_dir: Path, budget: Neural3dBudget) -> MethodSpec:
     def run(scene_dir: Path, protocol: str, artefacts_dir: Path = runs_dir):
         import torch
 
+        from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint
+
         # isort sees a module as first-party only once its file exists: keep this block as is.
         from neural3d.extract import extract_run  # noqa: I001
         from neural3d.train import train
 
+        torch.set_num_threads(budget.threads)
         device = torch.device(budget.device)
         run_dir = train(scene_dir, train_config, artefacts_dir, device=device,
-                        max_seconds=budget.minutes * 60.0)
+                        max_seconds=budget.max_minutes * 60.0)
+        state = read_checkpoint(run_dir / CHECKPOINT_NAME, torch.device("cpu"))
+        steps = int(state["step"])
         result = extract_run(run_dir, config=extract, device=device,
                              out_dir=run_dir / NEURAL3D_EXTRACT_FOLDER)
-        return replace(result, config={**result.config, **extra})
+        return replace(result, config={**result.config, **extra}, steps=steps,
+                       cut_short=steps < train_config.iterations,
+                       wall_time_s=0.0)  # the runner times the whole run
 
     requested = {**asdict(extract), **extra}
     return MethodSpec("neural3d", (NEURAL3D_PROTOCOL,), requested, run, has_footprint=True,
-                      resources=neural3d_resources(budget.device), artefacts_dir=runs_dir)
+                      resources=neural3d_resources(budget.device), artefacts_dir=runs_dir,
+                      code=NEURAL3D_CODE, libraries=NEURAL3D_LIBRARIES)
 
 
 def neural3d_resources(device: str) -> TaskResources:
@@ -151,20 +186,6 @@ def neural3d_resources(device: str) -> TaskResources:
     if device.startswith("cuda"):
         return TaskResources(cpus=1.0, gpus=1.0)
     return TaskResources(cpus=2.0)
-
-
-def read_only_specs(names: tuple[str, ...], views: tuple[str, ...]) -> list[MethodSpec]:
-    """Specs for reading stored results only (``--no-run``): nothing is imported or run."""
-    _check_names(names, views)
-
-    def run(scene_dir: Path, protocol: str):
-        raise RuntimeError("read-only comparison: methods are not run")
-
-    return [
-        MethodSpec(name, (NEURAL3D_PROTOCOL,) if name == "neural3d" else views, {}, run,
-                   has_footprint=name == "neural3d")
-        for name in names
-    ]
 
 
 def neural3d_extract_dir(results_dir: Path, scene: str) -> Path:

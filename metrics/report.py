@@ -12,31 +12,32 @@ from pathlib import Path
 from typing import Any
 
 from metrics.aggregate import ALL_FAMILIES, GroupSummary
-from metrics.errors import BuildingErrors, FacadeErrors
+from metrics.errors import CUT_SHORT, STALE, BuildingErrors, FacadeErrors, RunTiming
 from metrics.tables import Table, read_csv_rows
 
 TABLE2_NAME = "table2_errors"
 TABLE3_NAME = "table3_footprint_iou"
 PER_BUILDING_NAME = "per_building"
 PER_FACADE_NAME = "per_facade"
+TIMING_NAME = "timing"
 
 
 def table2_errors(groups: Sequence[GroupSummary]) -> Table:
     """Table 2: WWR, window-area and facade-area APE (%) per family, method and views."""
     rows = tuple(
         (g.family, g.method, g.protocol, g.buildings, g.failed,
-         g.wwr_ape, g.window_ape, g.facade_ape)
+         g.wwr_ape, g.window_ape, g.facade_ape, g.steps, g.marks)
         for g in groups
     )
     return Table(
         name=TABLE2_NAME,
         title="Absolute percentage error (%) of WWR, window area and facade area, mean ± std",
         columns=("Family", "Method", "Views", "Buildings", "Failed",
-                 "WWR error (%)", "Window error (%)", "Facade error (%)"),
+                 "WWR error (%)", "Window error (%)", "Facade error (%)", "Steps", "Marks"),
         keys=("family", "method", "protocol", "buildings", "failed",
-              "wwr_ape", "window_ape", "facade_ape"),
+              "wwr_ape", "window_ape", "facade_ape", "steps", "marks"),
         rows=rows,
-        notes=_failure_notes(groups),
+        notes=_failure_notes(groups) + _mark_notes(groups),
     )
 
 
@@ -53,13 +54,17 @@ def table3_footprint_iou(
     return Table(
         name=TABLE3_NAME,
         title="Footprint IoU with the ground truth, mean ± std",
-        columns=("Family", "Method", "Views", "Buildings", "Failed", "Footprint IoU"),
-        keys=("family", "method", "protocol", "buildings", "failed", "footprint_iou"),
+        columns=("Family", "Method", "Views", "Buildings", "Failed", "Footprint IoU", "Steps",
+                 "Marks"),
+        keys=("family", "method", "protocol", "buildings", "failed", "footprint_iou", "steps",
+              "marks"),
         rows=tuple(
-            (g.family, g.method, g.protocol, g.buildings, g.failed, g.footprint_iou)
+            (g.family, g.method, g.protocol, g.buildings, g.failed, g.footprint_iou, g.steps,
+             g.marks)
             for g in kept
         ),
-        notes=_failure_notes(kept) or (() if kept else ("no method estimates a footprint",)),
+        notes=(_failure_notes(kept) + _mark_notes(kept))
+        or (() if kept else ("no method estimates a footprint",)),
         decimals=3,
     )
 
@@ -116,7 +121,34 @@ def read_building_errors_csv(path: str | Path) -> list[BuildingErrors]:
 def _parse(text: str, type_name: Any) -> Any:
     if "float" in str(type_name):
         return float(text) if text != "" else None
+    if "int" in str(type_name):
+        return int(text) if text != "" else None
     return text
+
+
+def timing_table(timings: Sequence[RunTiming]) -> Table:
+    """How long each run took (s) and whether it ran now or was reused: the one output that
+    differs between reruns, so it is kept out of the other tables."""
+    names = tuple(f.name for f in fields(RunTiming))
+    return Table(
+        name=TIMING_NAME,
+        title="Wall time per run (s; reused results keep the time of the run that made them)",
+        columns=names,
+        keys=names,
+        rows=tuple(tuple(getattr(t, n) for n in names) for t in timings),
+        decimals=1,
+    )
+
+
+def _mark_notes(groups: Sequence[GroupSummary]) -> tuple[str, ...]:
+    notes = []
+    if any(CUT_SHORT in g.marks for g in groups):
+        notes.append(f"{CUT_SHORT}: the wall-clock safety cap stopped training before its step "
+                     "budget; the figure is not the budget's")
+    if any(STALE in g.marks for g in groups):
+        notes.append(f"{STALE}: kept with --reuse-stale although made by other code or "
+                     "settings; `python -m metrics.compare --explain SCENE METHOD` says what")
+    return tuple(notes)
 
 
 def _failure_notes(groups: Sequence[GroupSummary]) -> tuple[str, ...]:

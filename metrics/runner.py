@@ -1,10 +1,15 @@
 """Run only the missing (scene, method, protocol) results; reuse the ones already on disk.
 
-A stored result is reused when it reads back and its config matches the one
-requested (every key of the requested config has the same value in the
-stored one, compared as JSON). Otherwise the method runs and its result is
-written with :func:`dataset.results.write_result`. A method that raises is
-recorded as a failed outcome with its reason; the other runs go on.
+Results are keyed by their provenance record (:mod:`dataset.provenance`): the
+method's config, the fingerprint of the code it depends on, the scene's
+fingerprint (its ``transforms.json``, which records how it was rendered) and
+library versions. A stored result is reused only when its record equals the
+one the current code would write (:func:`expected_provenance`); otherwise the
+log says which part changed and the method runs again, unless ``reuse_stale``
+keeps it on purpose (its outcome is then ``"stale"`` and the tables mark it).
+Results are written with :func:`dataset.results.write_result`, carrying the
+record. A method that raises is recorded as a failed outcome with its reason;
+the other runs go on.
 
 The runs that are missing go to an executor (:data:`Execute`): here, one
 after the other in this process (:func:`execute_local`); on a Ray cluster
@@ -14,7 +19,6 @@ result files, as each run comes back.
 
 from __future__ import annotations
 
-import json
 import time
 import traceback
 from collections.abc import Callable, Iterator, Sequence
@@ -24,12 +28,14 @@ from typing import Any, Literal
 
 from tqdm import tqdm
 
+from dataset.provenance import Provenance, file_fingerprint, make_provenance, provenance_changes
 from dataset.ray_tasks import TaskResources
 from dataset.results import MethodResult, read_result, result_filename, write_result
 
 RunFn = Callable[[Path, str], MethodResult]
 """(scene folder, protocol) -> the method's result for that scene; may raise."""
-OutcomeStatus = Literal["reused", "ran", "failed"]
+OutcomeStatus = Literal["reused", "stale", "ran", "failed"]
+"""``stale``: a stored result whose provenance differs from the current one, kept on purpose."""
 
 
 @dataclass(frozen=True)
@@ -42,6 +48,9 @@ class MethodSpec:
     where ``run`` writes a folder per scene (named by the scene) that the
     comparison keeps (neural3d's run folder); such a ``run`` also takes an
     ``artefacts_dir=`` keyword to write it elsewhere (a worker on another machine).
+    ``code`` names the modules or packages whose source the results depend on and
+    ``libraries`` the distributions whose versions they depend on: both go into
+    each result's provenance record, so changing them recomputes the results.
     """
 
     name: str
@@ -51,6 +60,8 @@ class MethodSpec:
     has_footprint: bool = False
     resources: TaskResources = TaskResources()
     artefacts_dir: Path | None = None
+    code: tuple[str, ...] = ("dataset",)
+    libraries: tuple[str, ...] = ("numpy",)
 
 
 @dataclass(frozen=True)
@@ -108,9 +119,16 @@ def find_scenes(data: str | Path) -> list[Path]:
     return scenes
 
 
-def config_matches(requested: dict[str, Any], stored: dict[str, Any]) -> bool:
-    """Whether every key of ``requested`` has the same value in ``stored`` (nested, as JSON)."""
-    return _subset(_as_json(requested), _as_json(stored))
+def expected_provenance(scene_dir: Path, spec: MethodSpec) -> Provenance:
+    """The provenance record the current code writes for ``spec`` run on ``scene_dir``.
+
+    The scene's fingerprint is that of its ``transforms.json`` (generated scenes
+    record their own provenance in it, so a re-render changes it).
+    """
+    transforms = scene_dir / "transforms.json"
+    scene = file_fingerprint(transforms) if transforms.is_file() else "absent"
+    return make_provenance(spec.config, modules=spec.code, inputs={"scene": scene},
+                           libraries=spec.libraries)
 
 
 def run_missing(
@@ -119,19 +137,27 @@ def run_missing(
     results_dir: str | Path,
     *,
     allow_run: bool = True,
+    reuse_stale: bool = False,
     log: Callable[[str], None] = tqdm.write,
     execute: Execute = execute_local,
 ) -> list[Outcome]:
     """One :class:`Outcome` per (scene, method, protocol), in that nesting order.
 
-    The runs that are missing go to ``execute``; each result is written as it
-    comes back, so an interrupted call keeps what finished. With
-    ``allow_run=False`` nothing runs: any stored result is used whatever its
-    config, and a missing one is a failed outcome.
+    The runs that are missing or stale go to ``execute``; each result is
+    written as it comes back, with its provenance record, so an interrupted
+    call keeps what finished. With ``reuse_stale`` a stored result made by
+    other code or settings is kept (outcome ``"stale"``). With
+    ``allow_run=False`` nothing runs: any stored result is used (stale ones
+    marked so), and a missing one is a failed outcome.
     """
     results_dir = Path(results_dir)
     jobs = [Job(s, spec, p) for s in scene_dirs for spec in specs for p in spec.protocols]
-    outcomes: list[Outcome | None] = [_stored(job, results_dir, allow_run, log) for job in jobs]
+    records = {(j.scene_dir, j.spec.name): expected_provenance(j.scene_dir, j.spec)
+               for j in jobs}
+    outcomes: list[Outcome | None] = [
+        _stored(job, records[job.scene_dir, job.spec.name], results_dir,
+                keep_stale=reuse_stale or not allow_run, allow_run=allow_run, log=log)
+        for job in jobs]
     todo = [i for i, o in enumerate(outcomes) if o is None]
     with tqdm(total=len(jobs), initial=len(jobs) - len(todo), desc="results", unit="run",
               leave=False) as bar:
@@ -139,7 +165,9 @@ def run_missing(
             if outcomes[todo[k]] is not None:
                 raise RuntimeError(f"the executor returned run {k} twice")
             if outcome.result is not None:
-                outcome = replace(outcome, path=write_result(results_dir, outcome.result))
+                job = jobs[todo[k]]
+                result = replace(outcome.result, provenance=records[job.scene_dir, job.spec.name])
+                outcome = replace(outcome, result=result, path=write_result(results_dir, result))
             else:
                 log(f"{outcome.scene} / {outcome.method} / {outcome.protocol}: failed: "
                     f"{outcome.reason}")
@@ -172,27 +200,32 @@ def run_job(job: Job) -> Outcome:
     return Outcome(scene, spec.name, protocol, "ran", result)
 
 
-def _stored(job: Job, results_dir: Path, allow_run: bool,
-            log: Callable[[str], None]) -> Outcome | None:
+def _stored(job: Job, expected: Provenance, results_dir: Path, *, keep_stale: bool,
+            allow_run: bool, log: Callable[[str], None]) -> Outcome | None:
     """The outcome of ``job`` without running it, or ``None`` if it has to run."""
     scene, spec, protocol = job.scene_dir.name, job.spec, job.protocol
     path = results_dir / result_filename(scene, spec.name, protocol)
-    stale = ""
+    why = ""
     if path.is_file():
         try:
             stored = read_result(path)
         except ValueError as exc:
-            stale = f"corrupt result file: {exc}"
+            why = f"corrupt result file: {exc}"
         else:
-            if not allow_run or config_matches(spec.config, stored.config):
+            changes = provenance_changes(stored.provenance, expected)
+            if not changes:
                 return Outcome(scene, spec.name, protocol, "reused", stored, path=path)
-            stale = "stored result has another config"
+            why = "; ".join(str(c) for c in changes)
+            if keep_stale:
+                log(f"{scene} / {spec.name} / {protocol}: kept although stale ({why})")
+                return Outcome(scene, spec.name, protocol, "stale", stored, reason=why,
+                               path=path)
     if not allow_run:
-        reason = stale or f"no result file {path.name} (run without --no-run to compute it)"
+        reason = why or f"no result file {path.name} (run without --no-run to compute it)"
         log(f"{scene} / {spec.name} / {protocol}: {reason}")
         return Outcome(scene, spec.name, protocol, "failed", reason=reason, path=path)
-    if stale:
-        log(f"{scene} / {spec.name} / {protocol}: {stale}; recomputing")
+    if why:
+        log(f"{scene} / {spec.name} / {protocol}: {why}; recomputing")
     return None
 
 
@@ -208,15 +241,3 @@ def _where(exc: BaseException) -> str:
 
 def _is_scene(folder: Path) -> bool:
     return (folder / "transforms.json").is_file() or (folder / "building.json").is_file()
-
-
-def _as_json(obj: Any) -> Any:
-    return json.loads(json.dumps(obj, default=str))
-
-
-def _subset(requested: Any, stored: Any) -> bool:
-    if isinstance(requested, dict):
-        return isinstance(stored, dict) and all(
-            k in stored and _subset(v, stored[k]) for k, v in requested.items()
-        )
-    return requested == stored

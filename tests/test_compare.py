@@ -124,7 +124,8 @@ def test_per_facade_rows(compared):
      (["--views", "sideways"], "unknown views 'sideways'"),
      (["--device", "tpu"], "unknown device 'tpu'"),
      (["--device", "cuda:99"], "torch sees"),
-     (["--neural3d-minutes", "0"], "neural3d minutes must be > 0")],
+     (["--neural3d-max-minutes", "0"], "neural3d max minutes must be > 0"),
+     (["--neural3d-steps", "-3"], "neural3d steps must be >= 1")],
 )
 def test_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys, args, message):
     data, _ = make_benchmark(tmp_path)
