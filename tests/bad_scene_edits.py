@@ -135,7 +135,8 @@ SCENE_EDITS: dict[str, tuple[Edit, str]] = {
                       "semantic image must be single-channel"),
     "unknown_class_255": (unknown_class_id(IDEAL, 255), r"id 255 on \d+ pixels"),
     # Depth.
-    "zero_depth_on_building": (zero_depth_on_building(IDEAL), "building pixels have no valid depth"),
+    "zero_depth_on_building": (zero_depth_on_building(IDEAL),
+                               "building pixels have no valid depth"),
     "eight_bit_depth": (lambda r: write_labels(r / "depth" / IDEAL, np.ones((64, 64))),
                         "single-channel 16-bit"),
     "nan_depth_unit": (set_top("depth_unit_scale_factor", float("nan")),

@@ -12,10 +12,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import signal
-import subprocess
-import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -26,8 +22,8 @@ from conftest import make_box_building
 
 from baselines import wwr2ds, wwr2dss
 from dataset import generate, importer
-from dataset.meta_data import read_meta_data, write_meta_data
 from dataset.mesh import LabelledMesh, write_labelled_ply
+from dataset.meta_data import read_meta_data, write_meta_data
 from dataset.results import read_result
 from dataset.scene import read_scene
 from dataset.scene_writer import GenerateConfig, generate_scene
