@@ -37,15 +37,18 @@ def add_debug_flag(parser: argparse.ArgumentParser) -> None:
 
 
 def run_cli(prog: str, body: Callable[[], int], *, debug: bool = False,
-            interrupted: str = "interrupted: finished outputs are kept, run again to resume"
-            ) -> int:
-    """Run ``body`` and return its exit code; errors become one line on stderr (see module)."""
+            interrupted: str | Callable[[], str] = (
+                "interrupted: finished outputs are kept, run again to resume")) -> int:
+    """Run ``body`` and return its exit code; errors become one line on stderr (see module).
+
+    ``interrupted`` is the line for Ctrl-C, or a function that says it once the run stopped.
+    """
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             return body()
         except KeyboardInterrupt:
-            _say(interrupted)
+            _say(interrupted if isinstance(interrupted, str) else interrupted())
             return EXIT_INTERRUPTED
         except ValueError as exc:
             if debug:

@@ -286,8 +286,12 @@ def main(argv: list[str] | None = None) -> int:
                     max_seconds=max_s))
         return 0
 
-    return run_cli("neural3d.train", body, debug=args.debug, interrupted=(
-        f"interrupted: checkpoint saved in {run_dir}; continue with --resume"))
+    def interrupted() -> str:
+        if (run_dir / CHECKPOINT_NAME).is_file():
+            return f"interrupted: checkpoint saved in {run_dir}; continue with --resume"
+        return "interrupted before the first checkpoint; run the same command again"
+
+    return run_cli("neural3d.train", body, debug=args.debug, interrupted=interrupted)
 
 
 def read_run_config(run_dir: Path) -> TrainConfig:
