@@ -16,8 +16,10 @@ from pathlib import Path
 from tqdm import tqdm
 
 from baselines.views import PROTOCOLS
+from dataset.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
 from dataset.results import MethodResult, write_result
 from dataset.scene import Scene, read_scene
+from dataset.warnings_summary import summarise_warnings
 
 
 def scene_folders(data: Path) -> list[Path]:
@@ -50,7 +52,7 @@ def default_results_folder(data: Path) -> Path:
 
 
 def add_common_arguments(parser: argparse.ArgumentParser) -> None:
-    """--views, --data, --out and --debug-images."""
+    """--views, --data, --out, --debug-images and --debug."""
     parser.add_argument("--views", required=True, choices=PROTOCOLS,
                         help="view protocol: 'ideal' (one perpendicular view per facade) or "
                              "'multi' (several natural views per facade)")
@@ -62,6 +64,7 @@ def add_common_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--debug-images", type=Path, default=None, metavar="DIR",
                         help="also write debug PNGs <scene>__<protocol>__f<facade>__v<k>__<kind>"
                              ".png into DIR")
+    add_debug_flag(parser)
 
 
 def run_scenes(data: Path, out: Path | None, run_one: Callable[[Scene], MethodResult]) -> int:
@@ -76,28 +79,28 @@ def run_scenes(data: Path, out: Path | None, run_one: Callable[[Scene], MethodRe
         If ``data`` holds no scene or no scene could be measured.
     """
     folders = scene_folders(data)
-    out = default_results_folder(data) if out is None else Path(out)
+    out = check_output_folder(default_results_folder(data) if out is None else Path(out))
     written, failures = 0, []
     for folder in tqdm(folders, desc="scenes", unit="scene", disable=len(folders) < 2):
         try:
             result = run_one(read_scene(folder))
         except ValueError as exc:
-            failures.append(str(exc))
-            print(f"error: {exc}", file=sys.stderr)
+            failures.append(one_line(exc))
+            if len(folders) > 1:
+                print(f"error: {failures[-1]}", file=sys.stderr)
             continue
-        for w in result.warnings:
+        for w in summarise_warnings(result.warnings):
             print(f"warning: {w}", file=sys.stderr)
         print(write_result(out, result))
         written += 1
     if written == 0:
+        if len(folders) == 1:
+            raise ValueError(failures[0])
         raise ValueError(f"nothing was measured in {data} ({len(failures)} scene(s) failed)")
     return 0
 
 
-def main_guarded(prog: str, body: Callable[[], int]) -> int:
-    """Run a CLI body; a ValueError (a user's mistake) becomes one line on stderr and exit 2."""
-    try:
-        return body()
-    except ValueError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return 2
+def main_guarded(prog: str, body: Callable[[], int], debug: bool = False) -> int:
+    """Run a CLI body: a user's mistake becomes one line on stderr and exit 2
+    (:func:`dataset.cli_errors.run_cli`)."""
+    return run_cli(prog, body, debug=debug)

@@ -14,8 +14,8 @@ from typing import Literal
 import numpy as np
 
 from dataset.camera import Intrinsics
-from dataset.images import read_depth_m, read_labels
 from dataset.scene import Frame, Scene
+from dataset.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
 
 Protocol = Literal["ideal", "multi"]
 PROTOCOLS: tuple[str, ...] = ("ideal", "multi")
@@ -121,7 +121,9 @@ def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "
         view_name = f"{name}: view {frame.file_path} (facade {fid})"
         try:
             labels = _read_labels(scene, frame)
-            depth_z_m = None if depth == "no" else _read_depth(scene, frame)
+            depth_z_m = None if depth == "no" else _read_depth(scene, frame, labels)
+        except InvalidSceneError:  # a bad file is a bad scene, not a view to skip
+            raise
         except ViewError as exc:
             out.skip(view_name, fid, str(exc))
             continue
@@ -138,28 +140,9 @@ def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "
 def _read_labels(scene: Scene, frame: Frame) -> np.ndarray:
     if frame.semantic_file_path is None:
         raise ViewError("the frame has no semantic_file_path (semantic mask) in transforms.json")
-    try:
-        labels = read_labels(scene.path(frame.semantic_file_path))
-    except ValueError as exc:
-        raise ViewError(str(exc)) from exc
-    _check_size(labels, frame, frame.semantic_file_path)
-    return labels
+    return read_frame_labels(scene, frame)
 
 
-def _read_depth(scene: Scene, frame: Frame) -> np.ndarray:
+def _read_depth(scene: Scene, frame: Frame, labels: np.ndarray) -> np.ndarray:
     """Raises plain ValueError (not ViewError) so that callers decide whether depth matters."""
-    if frame.depth_file_path is None:
-        raise ValueError("the frame has no depth_file_path in transforms.json")
-    depth = read_depth_m(scene.path(frame.depth_file_path), scene.depth_unit_scale_factor)
-    _check_size(depth, frame, frame.depth_file_path, error=ValueError)
-    return depth
-
-
-def _check_size(img: np.ndarray, frame: Frame, path: str,
-                error: type[ValueError] = ViewError) -> None:
-    k = frame.intrinsics
-    if img.shape[:2] != (k.height, k.width):
-        raise error(
-            f"{path} is {img.shape[1]}x{img.shape[0]} but transforms.json says "
-            f"{k.width}x{k.height}"
-        )
+    return read_frame_depth_m(scene, frame, labels)

@@ -28,6 +28,7 @@ from baselines.debug import colour_labels, write_debug_image
 from baselines.facade_mask import facade_class_mask, isolate_facade_2ds
 from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
 from dataset.classes import SemanticClass
+from dataset.cli_errors import check_output_folder
 from dataset.results import FacadeEstimate, MethodResult
 from dataset.scene import Scene
 from dataset.wwr import wwr_from_areas
@@ -168,11 +169,13 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     def body() -> int:
+        if args.debug_images is not None:
+            check_output_folder(args.debug_images, "--debug-images")
         config = Wwr2dsConfig(isolation=args.isolation, combine=args.combine)
         return run_scenes(args.data, args.out, lambda s: run_2ds(
             s, args.views, config, debug_dir=args.debug_images))
 
-    return main_guarded(parser.prog, body)
+    return main_guarded(parser.prog, body, debug=args.debug)
 
 
 if __name__ == "__main__":

@@ -53,6 +53,7 @@ from baselines.rectify import (
     rectify_labels,
 )
 from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
+from dataset.cli_errors import check_output_folder
 from dataset.device import resolve_device
 from dataset.images import read_rgb
 from dataset.results import FacadeEstimate, MethodResult
@@ -273,6 +274,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     def body() -> int:
+        if args.debug_images is not None:
+            check_output_folder(args.debug_images, "--debug-images")
         device = resolve_device(args.device)
         if args.threads is not None:
             if args.threads < 1:
@@ -282,7 +285,7 @@ def main(argv: list[str] | None = None) -> int:
         return run_scenes(args.data, args.out, lambda s: run_2dss(
             s, args.views, config, debug_dir=args.debug_images, device=device))
 
-    return main_guarded(parser.prog, body)
+    return main_guarded(parser.prog, body, debug=args.debug)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ import argparse
 import shutil
 import signal
 import sys
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -23,8 +22,10 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
+from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.provenance import file_fingerprint
 from dataset.ray_tasks import RayConfig
+from dataset.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
 from dataset.scene_writer import (
     GenerateConfig,
     PlannedView,
@@ -116,10 +117,9 @@ def generate_preset(
 
 def check_writable(folder: Path) -> None:
     """Create ``folder`` if needed and make sure files can be written there (ValueError if not)."""
+    check_output_folder(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=folder):
-            pass
     except OSError as exc:
         raise ValueError(
             f"cannot write to output folder {folder}: {exc.strerror or exc}; choose another --out"
@@ -218,15 +218,15 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_debug_flag(p)
     return p.parse_args(argv)
 
 
 def main(argv: list[str] | None = None) -> int:
     """CLI entry point; returns the exit code (0 ok, 2 bad input, 130 interrupted)."""
     args = _parse_args(argv)
-    # `kill` (SIGTERM) stops the run as cleanly as Ctrl-C does.
-    previous = signal.signal(signal.SIGTERM, _interrupt_on_sigterm)
-    try:
+
+    def body() -> int:
         config = GenerateConfig(
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
             fov_deg=args.fov, supersampling=args.supersampling,
@@ -234,6 +234,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.executor == "ray" and args.preset is None:
             raise ValueError("--executor ray renders a preset's buildings as tasks; with --mesh "
                              "use --workers to split one building's frames over processes")
+        check_output_folder(args.out)
+        _check_resources(args, config)
         if args.preset is not None:
             ray = RayConfig(address=args.ray_address) if args.executor == "ray" else None
             scenes = generate_preset(args.preset, args.out, config, workers=args.workers,
@@ -241,21 +243,29 @@ def main(argv: list[str] | None = None) -> int:
                                      progress=not args.quiet, ray=ray)
         else:
             scenes = [_generate_mesh(args, config)]
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted: finished scenes are kept, unfinished ones were removed; "
-              "run the same command again to resume", file=sys.stderr)
-        return 130
-    except OSError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
+        for scene in scenes:
+            print(scene)
+        return 0
+
+    # `kill` (SIGTERM) stops the run as cleanly as Ctrl-C does.
+    previous = signal.signal(signal.SIGTERM, _interrupt_on_sigterm)
+    try:
+        return run_cli("dataset.generate", body, debug=args.debug, interrupted=(
+            "interrupted: finished scenes are kept, unfinished ones were removed; run the same "
+            "command again to resume"))
     finally:
         signal.signal(signal.SIGTERM, previous)
-    for scene in scenes:
-        print(scene)
-    return 0
+
+
+def _check_resources(args: argparse.Namespace, config: GenerateConfig) -> None:
+    from dataset.presets import preset_recipes
+
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    scenes = len(preset_recipes(args.preset)) if args.preset is not None else 1
+    check_generate_resources(config.resolution, config.supersampling,
+                             config.views + FACADE_VIEWS_PER_BUILDING, scenes,
+                             min(args.workers, scenes) if scenes > 1 else args.workers, args.out)
 
 
 def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:

@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from dataset.classes import FACADE_CLASSES, NO_FACADE, SemanticClass
+from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.facade_grouping import FacadeGroup, facade_ids_of_faces, group_facades
 from dataset.footprint import polygon_to_geojson
 from dataset.mesh import LabelledMesh, write_labelled_ply
@@ -284,23 +285,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--keep-position", action="store_true",
                         help="keep the file's coordinates instead of centring the building "
                         "on the origin with its lowest point at z = 0")
+    add_debug_flag(parser)
     args = parser.parse_args(argv)
-    try:
+
+    def body() -> int:
         config = ImportConfig(
             up_axis=args.up_axis, recentre=not args.keep_position,
             footprint_height_m=args.footprint_height_m, floor_height_m=args.floor_height_m,
         )
+        check_output_folder(args.scene_dir, "scene_dir")
         building = import_labelled_mesh(args.mesh, building_id=args.building_id, config=config)
         write_labelled_ply(args.scene_dir / "mesh.ply", building.mesh)
         write_building(args.scene_dir / "building.json", building.truth)  # last: marks done
-    except (ValueError, OSError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    t = building.truth
-    print(f"{t.id}: {len(t.facades)} facades, facade {t.facade_area_m2:.2f} m2, window "
-          f"{t.window_area_m2:.2f} m2, WWR {t.wwr:.4f}, footprint {t.footprint_area_m2:.2f} m2 "
-          f"-> {args.scene_dir}")
-    return 0
+        t = building.truth
+        print(f"{t.id}: {len(t.facades)} facades, facade {t.facade_area_m2:.2f} m2, window "
+              f"{t.window_area_m2:.2f} m2, WWR {t.wwr:.4f}, footprint "
+              f"{t.footprint_area_m2:.2f} m2 -> {args.scene_dir}")
+        return 0
+
+    return run_cli("dataset.importer", body, debug=args.debug)
 
 
 if __name__ == "__main__":

@@ -17,6 +17,7 @@ import numpy as np
 
 from dataset.classes import CLASS_NAMES, NO_FACADE, SemanticClass
 from dataset.mesh import LabelledMesh, read_labelled_ply
+from dataset.mesh_validation import check_mesh_coordinates
 
 UpAxis = Literal["z", "y"]
 MERGE_DECIMALS = 9  # vertices closer than ~1 nm are the same vertex (exporters print 6-17 digits)
@@ -71,7 +72,8 @@ def read_labelled_mesh_file(path: str | Path, *, up_axis: UpAxis = "z") -> Label
     Raises
     ------
     ValueError
-        Missing or unreadable file, unknown format, no labels, or part names that name no class.
+        Missing or unreadable file, unknown format, no labels, part names that name no class,
+        NaN coordinates or an absurd size (:mod:`dataset.mesh_validation`).
     """
     path = Path(path)
     if not path.is_file():
@@ -95,6 +97,7 @@ def read_labelled_mesh_file(path: str | Path, *, up_axis: UpAxis = "z") -> Label
         vertices = np.stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]], axis=1)
     elif up_axis != "z":
         raise ValueError(f"up_axis must be 'z' or 'y', got {up_axis!r}")
+    check_mesh_coordinates(vertices, faces, path)
     vertices, faces = merge_vertices(vertices, faces)
     return LabelledMesh(vertices, faces, labels, np.full(len(faces), NO_FACADE))
 

@@ -30,6 +30,7 @@ from dataset.atomic import write_json_atomic
 from dataset.camera import Intrinsics
 from dataset.classes import CLASS_NAMES, SemanticClass
 from dataset.scene import DEFAULT_DEPTH_UNIT_M, SPLITS, Frame, Scene
+from dataset.scene_validation import validate_scene
 
 PoseConvention = Literal["opencv", "opengl"]
 ClassIds = Literal["renderer", "generator", "envelope_bench"]
@@ -171,6 +172,7 @@ def read_meta_data(
     *,
     class_ids: ClassIds = "renderer",
     layout: MetaDataLayout = SDFSTUDIO_LAYOUT,
+    validate: bool = True,
 ) -> tuple[Scene, ClassMapping]:
     """Read a ``meta_data.json`` (or the folder holding one) into a :class:`Scene`.
 
@@ -185,6 +187,9 @@ def read_meta_data(
     layout
         :data:`SDFSTUDIO_LAYOUT` (default: OpenCV poses, paths relative to the file) or
         :data:`BUILDNET3D_LAYOUT` (OpenGL poses, ``images/`` and ``semantic/`` folders).
+    validate
+        Check the scene as :func:`dataset.scene.read_scene` does
+        (:func:`dataset.scene_validation.validate_scene`); ``False`` only for JSON-only tools.
 
     Returns
     -------
@@ -198,7 +203,8 @@ def read_meta_data(
     Raises
     ------
     ValueError
-        Missing file, malformed JSON, or a frame lacking a pose, intrinsics or image path.
+        Missing file, malformed JSON, a frame lacking a pose, intrinsics or image path, or
+        an invalid scene (:class:`dataset.scene_validation.InvalidSceneError`).
     """
     mapping = class_mapping(class_ids)
     path = Path(path)
@@ -211,7 +217,8 @@ def read_meta_data(
         frames = tuple(
             _frame_from_json(fr, width, height, layout) for fr in meta["frames"]
         )
-    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError,
+            AttributeError, OverflowError) as exc:
         raise ValueError(f"{file} is not a valid meta_data.json: {exc!r}") from exc
     if not frames:
         raise ValueError(f"{file} has no frames")
@@ -223,6 +230,8 @@ def read_meta_data(
         depth_unit_scale_factor=float(meta.get("depth_unit_scale_factor", DEFAULT_DEPTH_UNIT_M)),
         extra={k: v for k, v in meta.items() if k not in known},
     )
+    if validate:
+        validate_scene(scene)
     return scene, mapping
 
 

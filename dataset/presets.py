@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import argparse
 import re
-import sys
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from tqdm import tqdm
 
+from dataset.cli_errors import add_debug_flag, run_cli
 from dataset.l_shaped import make_l_shaped, sample_l_shaped_params
 from dataset.realistic import REALISTIC_MODELS, make_realistic, sample_realistic_params
 from dataset.skyscraper import make_skyscraper, sample_skyscraper_params
@@ -135,22 +135,24 @@ def main(argv: list[str] | None = None) -> int:
         "how many there are and the range of floors, footprint area, height and WWR.",
     )
     parser.add_argument("--preset", default="paper", help=f"one of {', '.join(PRESETS)}")
+    add_debug_flag(parser)
     args = parser.parse_args(argv)
-    try:
+
+    def body() -> int:
         recipes = preset_recipes(args.preset)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    truths = [build_building(r).truth for r in tqdm(recipes, desc="building", unit="building")]
-    print(f"preset {args.preset}: {len(truths)} buildings")
-    for family, ranges in preset_ranges(truths).items():
-        f, a, h, w = (ranges[k] for k in ("floors", "footprint_m2", "height_m", "wwr"))
-        print(
-            f"  {family:<10} n={ranges['count'][0]:>2}  floors {f[0]}-{f[1]}  "
-            f"footprint {a[0]:.1f}-{a[1]:.1f} m2  height {h[0]:.1f}-{h[1]:.1f} m  "
-            f"WWR {w[0]:.3f}-{w[1]:.3f}"
-        )
-    return 0
+        truths = [build_building(r).truth
+                  for r in tqdm(recipes, desc="building", unit="building")]
+        print(f"preset {args.preset}: {len(truths)} buildings")
+        for family, ranges in preset_ranges(truths).items():
+            f, a, h, w = (ranges[k] for k in ("floors", "footprint_m2", "height_m", "wwr"))
+            print(
+                f"  {family:<10} n={ranges['count'][0]:>2}  floors {f[0]}-{f[1]}  "
+                f"footprint {a[0]:.1f}-{a[1]:.1f} m2  height {h[0]:.1f}-{h[1]:.1f} m  "
+                f"WWR {w[0]:.3f}-{w[1]:.3f}"
+            )
+        return 0
+
+    return run_cli("dataset.presets", body, debug=args.debug)
 
 
 if __name__ == "__main__":

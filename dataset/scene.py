@@ -16,6 +16,7 @@ import numpy as np
 from dataset.atomic import write_json_atomic
 from dataset.camera import Intrinsics
 from dataset.classes import CLASS_NAMES
+from dataset.scene_validation import validate_scene
 from dataset.truth import BuildingTruth, read_building
 
 Split = Literal["train", "eval", "ideal", "multi"]
@@ -63,13 +64,19 @@ class Scene:
         return self.root / relative
 
 
-def read_scene(root: str | Path) -> Scene:
+def read_scene(root: str | Path, *, validate: bool = True) -> Scene:
     """Read a scene folder: ``transforms.json`` and, if present, ``building.json``.
+
+    The scene is validated (:func:`dataset.scene_validation.validate_scene`): paths
+    inside the folder, finite proper poses and intrinsics, every image present with
+    its declared size. ``validate=False`` is for tools that only read the JSON (a
+    method must never pass it).
 
     Raises
     ------
     ValueError
-        If the folder or its ``transforms.json`` is missing or malformed.
+        If the folder or its ``transforms.json`` is missing or malformed, or the scene
+        is invalid (:class:`dataset.scene_validation.InvalidSceneError`).
     """
     root = Path(root)
     tf = root / "transforms.json"
@@ -81,21 +88,27 @@ def read_scene(root: str | Path) -> Scene:
     try:
         meta = json.loads(tf.read_text())
         frames = tuple(_frame_from_json(fr, meta) for fr in meta["frames"])
-    except (json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+        classes = tuple(str(c) for c in meta.get("semantic_classes", CLASS_NAMES))
+        unit = float(meta.get("depth_unit_scale_factor", DEFAULT_DEPTH_UNIT_M))
+    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError,
+            AttributeError, OverflowError) as exc:
         raise ValueError(f"{tf} is malformed: {exc}") from exc
     building_json = root / "building.json"
     known = {
         "fl_x", "fl_y", "cx", "cy", "w", "h", "camera_model", "frames",
         "semantic_classes", "depth_unit_scale_factor",
     }
-    return Scene(
+    scene = Scene(
         root=root,
         frames=frames,
-        semantic_classes=tuple(meta.get("semantic_classes", CLASS_NAMES)),
-        depth_unit_scale_factor=float(meta.get("depth_unit_scale_factor", DEFAULT_DEPTH_UNIT_M)),
+        semantic_classes=classes,
+        depth_unit_scale_factor=unit,
         building=read_building(building_json) if building_json.is_file() else None,
         extra={k: v for k, v in meta.items() if k not in known},
     )
+    if validate:
+        validate_scene(scene)
+    return scene
 
 
 def write_transforms(root: str | Path, scene: Scene) -> None:

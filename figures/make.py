@@ -15,6 +15,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from dataset.atomic import write_json_atomic
+from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.results import code_version
 from figures.dataset_table import read_truths, table1_dataset
 from figures.footprints import footprint_pairs, plot_footprint_overlays
@@ -121,28 +122,29 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--data", type=Path,
                         help="benchmark folder (default: the one recorded in the comparison)")
     parser.add_argument("--out", type=Path, help="figures folder (default: <results>/figures)")
+    add_debug_flag(parser)
     return parser.parse_args(argv)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parse_args(argv)
-    data = args.data if args.data is not None else _default_data(args.results)
-    out = args.out or args.results / "figures"
-    try:
+
+    def body() -> int:
+        data = args.data if args.data is not None else _default_data(args.results)
+        out = args.out or args.results / "figures"
+        check_output_folder(out)
         made = make_figures(data, args.results, out)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    for name, paths in made.items():
-        if isinstance(paths, str):
-            print(f"skipped {name}: {paths}", file=sys.stderr)
-        else:
-            print(f"made {name}: {', '.join(p.name for p in paths)}")
-    if all(isinstance(v, str) for v in made.values()):
-        print(f"error: no figure could be made from {args.results}", file=sys.stderr)
-        return 2
-    print(f"figures in {out}")
-    return 0
+        for name, paths in made.items():
+            if isinstance(paths, str):
+                print(f"skipped {name}: {paths}", file=sys.stderr)
+            else:
+                print(f"made {name}: {', '.join(p.name for p in paths)}")
+        if all(isinstance(v, str) for v in made.values()):
+            raise ValueError(f"no figure could be made from {args.results}")
+        print(f"figures in {out}")
+        return 0
+
+    return run_cli("figures.make", body, debug=args.debug)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
+from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.device import resolve_device
 from dataset.ray_tasks import RayConfig
 from dataset.results import code_version
@@ -314,12 +315,14 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--ray-address", metavar="ADDR",
                         help="with --executor ray: a running cluster (HOST:PORT as printed by "
                         "`ray start --head`, or auto); default: start Ray on this machine")
+    add_debug_flag(parser)
     return parser.parse_args(argv)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parse_args(argv)
-    try:
+
+    def body() -> int:
         start = time.perf_counter()
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         views = tuple(v.strip() for v in args.views.split(",") if v.strip())
@@ -341,24 +344,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         data = (ensure_benchmark(default) if default is not None else args.data).resolve()
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
+        check_output_folder(results, "--results")
+        check_output_folder(out, "--out")
         specs = method_specs(methods, views, results, neural3d=budget)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
         comparison = compare(data, specs, results, out, allow_run=not args.no_run,
                              reuse_stale=args.reuse_stale,
                              command=f"python -m metrics.compare {argv_text}".strip(),
                              execute=execute)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("interrupted: finished results are kept; run again to continue", file=sys.stderr)
-        return 130
-    print()
-    print(to_text(comparison.table2))
-    print(to_text(comparison.table3))
-    print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
-          f"(results in {results}); {time.perf_counter() - start:.0f} s")
-    return 0
+        print()
+        print(to_text(comparison.table2))
+        print(to_text(comparison.table3))
+        print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
+              f"(results in {results}); {time.perf_counter() - start:.0f} s")
+        return 0
+
+    return run_cli("metrics.compare", body, debug=args.debug, interrupted=(
+        "interrupted: finished results are kept; run again to continue"))
 
 
 def _explain(args: argparse.Namespace, default: DefaultBenchmark | None,

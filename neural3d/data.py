@@ -15,8 +15,9 @@ import torch
 from torch import Tensor
 
 from dataset.camera import Intrinsics, rays_world
-from dataset.images import read_depth_m, read_labels, read_rgb
+from dataset.images import read_rgb
 from dataset.scene import Scene, Split
+from dataset.scene_validation import read_frame_depth_m, read_frame_labels
 from neural3d.normalisation import Normalisation
 from neural3d.scene_box import visual_hull_box_m
 
@@ -90,19 +91,14 @@ def load_frames(scene: Scene, split: Split, *, image_scale: float = 1.0,
             raise ValueError(f"frame {fr.file_path} has no depth_file_path (needed by "
                              "depth_loss); train without --depth-loss")
         rgb = read_rgb(scene.path(fr.file_path))
-        labels = read_labels(scene.path(fr.semantic_file_path))
-        depth = (read_depth_m(scene.path(fr.depth_file_path), scene.depth_unit_scale_factor)
-                 if with_depth else None)
+        labels = read_frame_labels(scene, fr)  # size and class ids checked
+        depth = read_frame_depth_m(scene, fr, labels) if with_depth else None
         k = fr.intrinsics
-        for name, img in (("image", rgb), ("semantic mask", labels), ("depth", depth)):
-            if img is not None and img.shape[:2] != (k.height, k.width):
-                raise ValueError(
-                    f"{name} of frame {fr.file_path} is {img.shape[1]}x{img.shape[0]} but its "
-                    f"intrinsics say {k.width}x{k.height}: fix transforms.json or the image"
-                )
-        if labels.max() >= len(scene.semantic_classes):
-            raise ValueError(f"semantic mask of {fr.file_path} holds class {labels.max()} but "
-                             f"the scene lists {len(scene.semantic_classes)} classes")
+        if rgb.shape[:2] != (k.height, k.width):
+            raise ValueError(
+                f"image of frame {fr.file_path} is {rgb.shape[1]}x{rgb.shape[0]} but its "
+                f"intrinsics say {k.width}x{k.height}: fix transforms.json or the image"
+            )
         if image_scale != 1.0:
             k = k.scaled(image_scale)
             size = (k.width, k.height)

@@ -28,8 +28,10 @@ import torch
 
 from dataset.atomic import write_json_atomic
 from dataset.classes import NUM_CLASSES, class_id_from_name
+from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.device import resolve_device
 from dataset.footprint import polygon_to_geojson
+from dataset.resources import check_mesh_resources
 from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
 from neural3d.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
 from neural3d.footprint import footprint_from_sdf
@@ -234,18 +236,24 @@ def main(argv: list[str] | None = None) -> int:
                         help="output folder (default: RUN/extract)")
     parser.add_argument("--device", choices=("cpu", "cuda"), default="cpu",
                         help="where to evaluate the field (default cpu)")
+    add_debug_flag(parser)
     args = parser.parse_args(argv)
-    try:
-        result = extract_run(args.run, config=ExtractConfig(resolution=args.resolution),
-                             device=resolve_device(args.device), out_dir=args.out,
-                             progress=True)
-    except ValueError as exc:
-        print(f"neural3d.extract: {exc}", file=sys.stderr)
-        return 2
-    wwr = "n/a" if result.wwr is None else f"{result.wwr:.3f}"
-    print(f"{result.scene}: WWR {wwr}, facade {result.facade_area_m2:.1f} m², "
-          f"window {result.window_area_m2:.1f} m², {result.wall_time_s:.1f} s")
-    return 0
+
+    def body() -> int:
+        config = ExtractConfig(resolution=args.resolution)
+        check_mesh_resources(config.resolution)
+        if args.out is not None:
+            check_output_folder(args.out)
+        result = extract_run(args.run, config=config, device=resolve_device(args.device),
+                             out_dir=args.out, progress=True)
+        wwr = "n/a" if result.wwr is None else f"{result.wwr:.3f}"
+        facade = "n/a" if result.facade_area_m2 is None else f"{result.facade_area_m2:.1f}"
+        window = "n/a" if result.window_area_m2 is None else f"{result.window_area_m2:.1f}"
+        print(f"{result.scene}: WWR {wwr}, facade {facade} m², window {window} m², "
+              f"{result.wall_time_s:.1f} s")
+        return 0
+
+    return run_cli("neural3d.extract", body, debug=args.debug)
 
 
 if __name__ == "__main__":

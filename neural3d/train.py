@@ -25,7 +25,9 @@ import torch
 from tqdm import tqdm
 
 from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.device import resolve_device
+from dataset.resources import check_training_resources
 from dataset.results import code_version
 from dataset.scene import read_scene
 from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
@@ -80,6 +82,10 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     scene = read_scene(scene_dir)
     run_dir = Path(out_dir) / scene_name(scene_dir)
     bg = background_class(scene)
+    check_training_resources(sum(
+        round(f.intrinsics.width * config.image_scale) * round(f.intrinsics.height
+                                                               * config.image_scale)
+        for f in scene.frames_in("train")))
     frames = load_frames(scene, "train", image_scale=config.image_scale,
                          with_depth=config.depth_loss)
     if resume:
@@ -199,12 +205,17 @@ def _check_resumable(run_dir: Path, config: TrainConfig) -> Normalisation:
         if not (run_dir / name).is_file():
             raise ValueError(f"cannot resume: {run_dir / name} does not exist (train without "
                              "--resume first)")
-    saved = config_from_dict(json.loads((run_dir / "config.json").read_text()))
+    saved = read_run_config(run_dir)
     if saved != config:
         raise ValueError(f"cannot resume: {run_dir} was trained with another config; resume "
                          "with the config in its config.json")
-    run = json.loads((run_dir / "run.json").read_text())
-    return Normalisation.from_json_dict(run["normalisation"])
+    try:
+        run = json.loads((run_dir / "run.json").read_text())
+        return Normalisation.from_json_dict(run["normalisation"])
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
+            ValueError) as exc:
+        raise ValueError(f"cannot resume: {run_dir / 'run.json'} is damaged ({exc}); train "
+                         "again without --resume") from exc
 
 
 def _write_log(run_dir: Path, rows: list[dict]) -> None:
@@ -225,7 +236,13 @@ def _read_log(run_dir: Path) -> list[dict]:
 
 def _read_evals(run_dir: Path) -> list[dict]:
     path = run_dir / "eval.json"
-    return json.loads(path.read_text())["evaluations"] if path.is_file() else []
+    if not path.is_file():
+        return []
+    try:
+        return list(json.loads(path.read_text())["evaluations"])
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError) as exc:
+        raise ValueError(f"cannot resume: {path} is damaged ({exc}); delete it to resume "
+                         "without the evaluation history") from exc
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -248,29 +265,43 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--iterations", type=int, default=None, help="override the preset")
     parser.add_argument("--depth-loss", action="store_true",
                         help="variant: also supervise rendered depth with the depth images")
+    add_debug_flag(parser)
     args = parser.parse_args(argv)
-    try:
-        run_dir = Path(args.out) / scene_name(args.scene)
+    run_dir = Path(args.out) / scene_name(args.scene)
+
+    def body() -> int:
         if args.resume and args.preset is None and (run_dir / "config.json").is_file():
-            config = config_from_dict(json.loads((run_dir / "config.json").read_text()))
+            config = read_run_config(run_dir)
         else:
             config = preset_config(args.preset or "fast")
             if args.iterations is not None:
                 config = replace(config, iterations=args.iterations)
             if args.depth_loss:
                 config = replace(config, depth_loss=True)
+        if args.max_minutes is not None and not args.max_minutes > 0:
+            raise ValueError(f"--max-minutes must be > 0, got {args.max_minutes}")
+        check_output_folder(args.out)
         max_s = None if args.max_minutes is None else 60.0 * args.max_minutes
-        out = train(args.scene, config, args.out, device=args.device, resume=args.resume,
-                    max_seconds=max_s)
-    except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"interrupted: checkpoint saved in {run_dir}; continue with --resume",
-              file=sys.stderr)
-        return 130
-    print(out)
-    return 0
+        print(train(args.scene, config, args.out, device=args.device, resume=args.resume,
+                    max_seconds=max_s))
+        return 0
+
+    def interrupted() -> str:
+        if (run_dir / CHECKPOINT_NAME).is_file():
+            return f"interrupted: checkpoint saved in {run_dir}; continue with --resume"
+        return "interrupted before the first checkpoint; run the same command again"
+
+    return run_cli("neural3d.train", body, debug=args.debug, interrupted=interrupted)
+
+
+def read_run_config(run_dir: Path) -> TrainConfig:
+    """The config a run folder was trained with (ValueError if its config.json is unreadable)."""
+    path = Path(run_dir) / "config.json"
+    try:
+        return config_from_dict(json.loads(path.read_text()))
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError) as exc:
+        raise ValueError(f"{path} is not a valid neural3d config: {exc}; train again without "
+                         "--resume") from exc
 
 
 if __name__ == "__main__":

@@ -96,16 +96,22 @@ def load_trained_field(run_dir: Path, *, device: torch.device) -> TrainedField:
         if not (run_dir / name).is_file():
             raise ValueError(f"{run_dir} is not a neural3d run folder: {name} is missing "
                              "(train one with `python -m neural3d.train`)")
-    config = config_from_dict(json.loads((run_dir / "config.json").read_text()))
-    run = json.loads((run_dir / "run.json").read_text())
-    norm = Normalisation.from_json_dict(run["normalisation"])
-    field = build_field(config.model, len(run["class_names"]), norm).to(device)
+    try:
+        config = config_from_dict(json.loads((run_dir / "config.json").read_text()))
+        run = json.loads((run_dir / "run.json").read_text())
+        norm = Normalisation.from_json_dict(run["normalisation"])
+        class_names = tuple(str(c) for c in run["class_names"])
+        scene_dir = Path(run["scene_dir"])
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
+            ValueError) as exc:
+        raise ValueError(f"{run_dir} holds a damaged config.json or run.json ({exc}); train "
+                         "the run again") from exc
+    field = build_field(config.model, len(class_names), norm).to(device)
     state = read_checkpoint(run_dir / "checkpoint.pt", device)
     field.load_state_dict(state["field"])
     field.set_step(int(state["step"]))
     field.eval()
-    return TrainedField(field, norm, scene_dir=Path(run["scene_dir"]),
-                        class_names=tuple(run["class_names"]))
+    return TrainedField(field, norm, scene_dir=scene_dir, class_names=class_names)
 
 
 def build_field(model_config: FieldConfig, num_classes: int, norm: Normalisation) -> SemanticSDF:

@@ -10,6 +10,7 @@ from baselines.views import load_views
 from dataset.camera import Intrinsics
 from dataset.images import write_labels
 from dataset.scene import read_scene, write_transforms
+from dataset.scene_validation import InvalidSceneError
 
 K = Intrinsics.from_fov(64, 48, 60.0)
 FACADE = dict(length_m=12.0, height_m=9.0, windows=window_grid(12.0, 9.0, 4, 3, 1.6, 1.5))
@@ -22,28 +23,37 @@ def scene(tmp_path):
     s = write_facade_scene(tmp_path / "scene_a", views, K, **FACADE)
     f = list(s.frames)
     f[1] = replace(f[1], facade_id=None)  # no facade_id
-    f[3] = replace(f[3], semantic_file_path="semantics/missing.png")
-    (tmp_path / "scene_a" / "semantics" / "ideal_004.png").write_bytes(b"not a png")
+    f[3] = replace(f[3], semantic_file_path=None)
     f[5] = replace(f[5], depth_file_path=None)
-    write_labels(tmp_path / "scene_a" / "semantics" / "ideal_006.png", np.zeros((10, 10)))
     write_transforms(s.root, replace(s, frames=tuple(f)))
     return read_scene(s.root)
 
 
 def test_bad_views_are_skipped_with_one_warning_each(scene):
     loaded = load_views(scene, "ideal", depth="required")
-    assert [(v.facade_id, v.view_index) for v in loaded.views] == [(1, 0), (2, 0)]
+    assert [(v.facade_id, v.view_index) for v in loaded.views] == [(1, 0), (2, 0), (4, 0),
+                                                                     (6, 0)]
     assert loaded.facade_ids == [1, 2, 3, 4, 5, 6]  # every named facade, usable or not
     w = loaded.warnings
-    assert len(w) == 5
+    assert len(w) == 3
     assert w[0] == ("scene_a: view images/ideal_001.png skipped: the frame has no facade_id "
                     "in transforms.json")
-    assert "view images/ideal_003.png (facade 3) skipped: image" in w[1]
-    assert "semantics/missing.png does not exist" in w[1]
-    assert "ideal_004.png cannot be read" in w[2]
-    assert "(facade 5) skipped: the frame has no depth_file_path" in w[3]
-    assert "semantics/ideal_006.png is 10x10 but transforms.json says 64x48" in w[4]
-    assert set(loaded.skipped) == {3, 4, 5, 6}
+    assert "view images/ideal_003.png (facade 3) skipped: the frame has no semantic_file_path" \
+        in w[1]
+    assert "(facade 5) skipped: the frame has no depth_file_path" in w[2]
+    assert set(loaded.skipped) == {3, 5}
+
+
+def test_missing_corrupt_or_mis_sized_images_make_the_scene_invalid(scene):
+    (scene.root / "semantics" / "ideal_004.png").write_bytes(b"not a png")
+    write_labels(scene.root / "semantics" / "ideal_006.png", np.zeros((10, 10)))
+    (scene.root / "depth" / "ideal_002.png").unlink()
+    with pytest.raises(InvalidSceneError) as info:
+        read_scene(scene.root)
+    message = str(info.value)
+    assert "depth/ideal_002.png: does not exist" in message
+    assert "ideal_004.png: is not a readable image" in message
+    assert "semantics/ideal_006.png: is 10x10 but transforms.json says 64x48" in message
 
 
 def test_optional_depth_keeps_the_view_and_warns(scene):

@@ -62,7 +62,7 @@ def _scene(tmp_path):
              (3, facade_pose(L_M, H_M, distance_m=16.0, azimuth_deg=0.0))]
     s = write_facade_scene(tmp_path / "bench" / "facade_scene", poses, K, **FACADE)
     frames = list(s.frames)
-    frames[3] = replace(frames[3], semantic_file_path="semantics/gone.png")
+    frames[3] = replace(frames[3], semantic_file_path=None)
     write_transforms(s.root, replace(s, frames=tuple(frames)))
     return read_scene(s.root)
 
@@ -72,10 +72,10 @@ def test_run_averages_views_then_facades_and_reports_missing(tmp_path):
     assert (r.method, r.protocol, r.scene) == ("2D-S", "ideal", "facade_scene")
     f1, f2, f3 = r.facades
     assert (f1.views_used, f2.views_used, f3.missing) == (1, 2, True)
-    assert "semantics/gone.png does not exist" in f3.reason
+    assert "no semantic_file_path" in f3.reason
     assert r.wwr == pytest.approx((f1.wwr + f2.wwr) / 2)  # unweighted over facades present
     assert r.facade_area_m2 == pytest.approx(f1.facade_area_m2 + f2.facade_area_m2)
-    assert any("skipped" in w and "gone.png" in w for w in r.warnings)
+    assert any("skipped" in w and "no semantic_file_path" in w for w in r.warnings)
     assert (tmp_path / "dbg" / "facade_scene__ideal__f2__v1__mask.png").is_file()
     assert r.config == {"isolation": "centre_component", "combine": "mean"}
 

@@ -22,7 +22,7 @@ from baselines.wwr2dss import (
     run_2dss,
 )
 from dataset.camera import Intrinsics, look_at
-from dataset.images import write_depth_m, write_labels
+from dataset.images import write_depth_m, write_labels, write_rgb
 from dataset.render import render_ground_truth
 from dataset.results import read_result
 from dataset.scene import Frame, read_scene, write_transforms
@@ -114,6 +114,7 @@ def _two_facade_scene(tmp_path):
     labels, depth = render_facade(k, pose2, length_m=24.0, height_m=6.0, windows=wins2)
     write_labels(root / "semantics" / "b.png", labels)
     write_depth_m(root / "depth" / "b.png", depth, 0.001)
+    write_rgb(root / "images" / "b.png", np.zeros((*labels.shape, 3), np.uint8))
     f2 = Frame("images/b.png", pose2, k, "ideal", facade_id=2, depth_file_path="depth/b.png",
                semantic_file_path="semantics/b.png")
     write_transforms(root, replace(a, frames=(*a.frames, f2)))
@@ -141,22 +142,24 @@ def test_every_bad_view_is_skipped_with_its_reason(tmp_path):
     views = [(1, far), (2, near), (3, far), (4, far), (5, far), (6, far)]
     s = write_facade_scene(tmp_path / "bad", views, k, **FACADE)
     write_labels(s.root / "semantics" / "ideal_002.png", np.zeros((96, 128)))  # no facade
-    write_depth_m(s.root / "depth" / "ideal_003.png", np.zeros((96, 128)), 0.001)  # no depth
     frames = list(s.frames)
     frames[4] = replace(frames[4], facade_id=None)
-    frames[5] = replace(frames[5], depth_file_path="depth/gone.png")
+    frames[5] = replace(frames[5], depth_file_path=None)
     write_transforms(s.root, replace(s, frames=tuple(frames)))
     r = run_2dss(read_scene(s.root), "ideal")
     reasons = {f.id: f.reason for f in r.facades if f.missing}
-    assert set(reasons) == {2, 3, 4, 6} and not r.facades[0].missing
+    assert set(reasons) == {2, 3, 6} and not r.facades[0].missing
     assert "cut off" in reasons[2]
     assert "no facade pixels" in reasons[3]
-    assert "no valid depth on the facade" in reasons[4]
-    assert "depth/gone.png does not exist" in reasons[6]
-    assert sum("skipped" in w for w in r.warnings) == 5  # the frame without facade_id too
+    assert "no depth_file_path" in reasons[6]
+    assert sum("skipped" in w for w in r.warnings) == 4  # the frame without facade_id too
     assert any("images/ideal_004.png skipped: the frame has no facade_id" in w
                for w in r.warnings)
-    assert any("4 of 5 facades missing" in w for w in r.warnings)
+    assert any("3 of 5 facades missing" in w for w in r.warnings)
+    # No depth where the mask shows the facade is a bad scene, not a view to skip.
+    write_depth_m(s.root / "depth" / "ideal_003.png", np.zeros((96, 128)), 0.001)
+    with pytest.raises(ValueError, match="ideal_003.png: .* building pixels have no valid depth"):
+        run_2dss(read_scene(s.root), "ideal")
 
 
 def test_cli_writes_results_and_debug_images(tmp_path, capsys):

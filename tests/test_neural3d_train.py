@@ -140,7 +140,7 @@ def test_scene_errors(scene, tmp_path):
         train(copy, SHORT, tmp_path / "runs", device=CPU)
     _edit_transforms(copy, lambda m: [f.update(split="train") for f in m["frames"]])
     _edit_transforms(copy, lambda m: m.update(w=40))
-    with pytest.raises(ValueError, match="intrinsics say 40x32"):
+    with pytest.raises(ValueError, match="is 32x32 but transforms.json says 40x32"):
         train(copy, SHORT, tmp_path / "runs", device=CPU)
     with pytest.raises(ValueError, match="unknown device"):
         train(scene, SHORT, tmp_path / "runs", device="tpu-9")
