@@ -356,7 +356,8 @@ def test_train_resume_with_a_damaged_config(scene, tmp_path, capsys):
     (["--views", "sideways"], "unknown views 'sideways'"),
     (["--out", "{file}"], "--out .* is an existing file"),
     (["--results", "{file}"], "--results .* is an existing file"),
-    (["--neural3d-minutes", "-1"], "minutes must be > 0"),
+    (["--neural3d-max-minutes", "-1"], "max minutes must be > 0"),
+    (["--neural3d-steps", "0"], "steps must be >= 1"),
 ])
 def test_compare_refuses_bad_values(argv, pattern, scene, tmp_path, capsys):
     argv = [a.format(tmp=tmp_path, file=_file(tmp_path)) for a in argv]
