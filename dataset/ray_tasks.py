@@ -103,7 +103,8 @@ def ray_session(config: RayConfig) -> Iterator[None]:
         options.update(num_cpus=config.num_cpus,
                        object_store_memory=LOCAL_OBJECT_STORE_MB * 2**20)
     try:
-        ray.init(address=config.address, **options)
+        # "local": a new Ray for this run, never one that happens to run here already.
+        ray.init(address=config.address or "local", **options)
     except ConnectionError as exc:
         raise ValueError(
             f"cannot reach a Ray cluster at {config.address!r}: {exc}; start one with "
