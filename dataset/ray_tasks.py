@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import logging
 import os
+import socket
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -96,6 +97,8 @@ def ray_session(config: RayConfig) -> Iterator[None]:
     if ray.is_initialized():
         yield
         return
+    if config.address is not None:
+        _check_reachable(config.address)
     options: dict[str, Any] = {
         "include_dashboard": False, "log_to_driver": False, "logging_level": logging.WARNING,
     }
@@ -103,11 +106,14 @@ def ray_session(config: RayConfig) -> Iterator[None]:
         options.update(num_cpus=config.num_cpus,
                        object_store_memory=LOCAL_OBJECT_STORE_MB * 2**20)
     try:
-        ray.init(address=config.address, **options)
+        # "local": a new Ray for this run, never one that happens to run here already.
+        ray.init(address=config.address or "local", **options)
     except ConnectionError as exc:
         raise ValueError(
-            f"cannot reach a Ray cluster at {config.address!r}: {exc}; start one with "
-            "`ray start --head` and pass the address it prints to --ray-address"
+            f"cannot join the Ray cluster at {config.address!r}: {exc}; pass the address that "
+            "`ray start --head` printed, and if the cluster uses token authentication (the "
+            "default of `ray start --head`) set RAY_AUTH_MODE=token here with the head's "
+            "~/.ray/auth_token"
         ) from exc
     try:
         yield
@@ -156,6 +162,20 @@ def run_tasks(
     finally:
         for ref in pending:  # Ctrl-C or an early exit: nothing keeps running for nobody
             ray.cancel(ref)
+
+
+def _check_reachable(address: str, timeout_s: float = 5.0) -> None:
+    """Fail fast on a ``HOST:PORT`` nobody answers at (Ray itself retries for minutes)."""
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        return  # "auto" and other forms Ray resolves itself
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout_s).close()
+    except OSError as exc:
+        raise ValueError(
+            f"cannot reach a Ray cluster at {address!r}: {exc.strerror or exc}; start one with "
+            "`ray start --head` and pass the address it prints to --ray-address"
+        ) from exc
 
 
 def _check_fits(calls: Sequence[tuple[tuple[Any, ...], TaskResources]],

@@ -11,6 +11,8 @@ import io
 import os
 import shutil
 import signal
+import subprocess
+import sys
 import threading
 import time
 from dataclasses import replace
@@ -36,7 +38,7 @@ CONFIG = RayConfig(max_retries=1)
 @pytest.fixture(scope="module")
 def local_ray():
     """One local Ray for the module (starting one takes seconds), on loopback only."""
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False,
              object_store_memory=200 * 2**20)
     assert {n["NodeManagerAddress"] for n in ray.nodes()} == {"127.0.0.1"}
     yield
@@ -214,3 +216,31 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
     assert [(o.scene, o.method, o.status) for o in again if o.status == "ran"] == [
         (slow_scene, "slow", "ran")]
     assert len(again) == 2 * len(scenes)
+
+
+def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
+    """``python -m metrics.compare --executor ray`` (its own Ray) gets SIGINT after its first
+    result, while neural3d (5 minutes per building) still runs or waits."""
+    results = tmp_path / "results"
+    command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
+               "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-minutes", "5",
+               "--results", str(results), "--out", str(tmp_path / "out"), "--executor", "ray"]
+    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list(results.glob("*.json")) and proc.poll() is None:
+        if time.monotonic() > deadline:
+            proc.kill()
+            pytest.fail(f"no result appeared: {proc.communicate()[1][-3000:]}")
+        time.sleep(0.1)
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stderr
+    assert "interrupted" in stderr
+    written = sorted(p for p in results.iterdir() if p.is_file())
+    assert written and all(p.name.endswith("__2D-S__ideal.json") for p in written)
+    for path in written:  # whole files only: each reads back
+        read_result(path)
+    runs = results / "neural3d_runs"
+    assert not runs.exists() or not any(runs.iterdir())  # no half-returned run folder
+    assert not (tmp_path / "out").exists()  # no table was written
