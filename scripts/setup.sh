@@ -11,6 +11,6 @@ if ! "$PY" -c "import torch" >/dev/null 2>&1; then
     "$PY" -m pip install --quiet torch==2.13.0
 fi
 "$PY" -m pip install --quiet --disable-pip-version-check -e ".[test]"
-"$PY" -c "import torch, trimesh, embreex, kornia, cv2, skimage, shapely" \
+"$PY" -c "import torch, trimesh, embreex, kornia, cv2, skimage, shapely, ifcopenshell" \
     || { echo "setup: a dependency failed to import; see the messages above" >&2; exit 1; }
 echo "setup: done ($("$PY" -c 'import torch; print("torch", torch.__version__)'))"
