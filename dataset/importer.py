@@ -3,7 +3,8 @@
 Steps (docs/importing.md): read the file (:mod:`dataset.mesh_files`); check its bodies are
 closed and consistently oriented (they may touch or overlap) and carry facade classes; move
 it to the origin with its ground at z = 0 and cut the faces that cross the ground
-(:mod:`dataset.grade`); find the wall/window/door faces above the ground seen from outside
+(:mod:`dataset.grade`) and where another body's face lies against them
+(:mod:`dataset.contact`); find the wall/window/door faces above the ground seen from outside
 (:mod:`dataset.visibility`, through :mod:`dataset.raycast`); group them into facades
 (:mod:`dataset.facade_grouping`); sum areas per class and facade; cut the footprint
 ``footprint_height_m`` above the ground (:mod:`dataset.section`).
@@ -19,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from dataset.classes import FACADE_CLASSES, NO_FACADE, SemanticClass
+from dataset.contact import split_touching_faces
 from dataset.facade_grouping import FacadeGroup, facade_ids_of_faces, group_facades
 from dataset.footprint import polygon_to_geojson
 from dataset.grade import edge_balance, split_at_height
@@ -122,7 +124,11 @@ def building_from_mesh(
     mesh, parent = split_at_height(
         LabelledMesh(vertices, faces, mesh.face_label, mesh.face_facade), grade_z
     )
-    parent = kept[parent]
+    is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
+    mesh, touching_parent = split_touching_faces(
+        mesh, is_facade_class & (mesh.triangles_m[:, :, 2].mean(axis=1) > grade_z)
+    )
+    parent = kept[parent[touching_parent]]
     vertices, faces = mesh.vertices_m, mesh.faces
 
     areas, normals = mesh.face_areas_m2(), mesh.face_normals()
