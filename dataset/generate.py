@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
+from dataset.import_config import add_import_arguments
 from dataset.scene_writer import (
     GenerateConfig,
     PlannedView,
@@ -154,7 +155,8 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
         epilog=(
             "examples: python -m dataset.generate --preset tiny --out data/tiny | "
             "python -m dataset.generate --preset paper --out data/paper --workers 2 | "
-            "python -m dataset.generate --mesh house.ply --out data/mine. "
+            "python -m dataset.generate --mesh house.ply --out data/mine | "
+            "python -m dataset.generate --ifc house.ifc --out data/mine. "
             "Layout and options: docs/rendering.md."
         ),
     )
@@ -163,6 +165,11 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     src.add_argument("--mesh", type=Path, metavar="FILE",
                      help="your labelled mesh (.ply with per-face label, or .obj/.glb with "
                           "class-named parts), metres, z up; see docs/importing.md")
+    src.add_argument("--ifc", type=Path, metavar="FILE",
+                     help="an IFC model (ArchiCAD, Revit, ... export); see docs/importing.md")
+    p.add_argument("--ifc-classes", type=Path, metavar="JSON",
+                   help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
+                        '{"IfcCovering": "wall", "IfcRailing": "skip"}')
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
     p.add_argument("--resolution", type=int, default=d.resolution,
@@ -182,6 +189,7 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_import_arguments(p)  # with --mesh or --ifc
     return p.parse_args(argv)
 
 
@@ -219,9 +227,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
-    from dataset.importer import import_labelled_mesh
+    from dataset.import_source import import_from_args
 
-    building = import_labelled_mesh(args.mesh)
+    building = import_from_args(args)
     check_writable(args.out)
     name = building.truth.id
     _remove_stale_partials(args.out, name)

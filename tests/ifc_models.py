@@ -27,8 +27,9 @@ Vec = tuple[float, float, float]
 class IfcHouse:
     """An IFC4 file with one site, one building and its storeys, built box by box."""
 
-    def __init__(self, *, millimetres: bool = False):
+    def __init__(self, *, millimetres: bool = False, origin: Vec = (0.0, 0.0, 0.0)):
         api = ifcopenshell.api
+        self.origin = np.asarray(origin, dtype=np.float64)  # where (0, 0, 0) of the plan lies
         self.file = api.project.create_file(version="IFC4")
         f = self.file
         project = api.root.create_entity(f, ifc_class="IfcProject", name="test project")
@@ -50,8 +51,9 @@ class IfcHouse:
     def storey(self, name: str, elevation_m: float) -> ifcopenshell.entity_instance:
         api, f = ifcopenshell.api, self.file
         s = api.root.create_entity(f, ifc_class="IfcBuildingStorey", name=name)
-        s.Elevation = elevation_m * self.scale
-        api.geometry.edit_object_placement(f, product=s, matrix=_translation((0, 0, elevation_m)))
+        s.Elevation = (self.origin[2] + elevation_m) * self.scale
+        api.geometry.edit_object_placement(
+            f, product=s, matrix=_translation(self.origin + (0, 0, elevation_m)))
         api.aggregate.assign_object(f, products=[s], relating_object=self.building)
         self.storeys[name] = s
         return s
@@ -68,7 +70,7 @@ class IfcHouse:
             f, context=self.body, length=float(size[0]), thickness=float(size[1]),
             height=float(size[2]))
         api.geometry.assign_representation(f, product=e, representation=rep)
-        api.geometry.edit_object_placement(f, product=e, matrix=_translation(lo))
+        api.geometry.edit_object_placement(f, product=e, matrix=_translation(self.origin + lo))
         if parent is not None:
             api.aggregate.assign_object(f, products=[e], relating_object=parent)
         elif ifc_class != "IfcOpeningElement":
@@ -88,7 +90,8 @@ class IfcHouse:
         element = self.box(ifc_class, tuple(plo), tuple(phi))
         api.feature.add_filling(f, opening=opening, element=element)
         width = hi[1 - axis] - lo[1 - axis]
-        element.OverallWidth, element.OverallHeight = width * self.scale, (hi[2] - lo[2]) * self.scale
+        element.OverallWidth = width * self.scale
+        element.OverallHeight = (hi[2] - lo[2]) * self.scale
         return element
 
     def write(self, path: Path) -> Path:
@@ -104,10 +107,12 @@ def _translation(xyz) -> np.ndarray:
 
 # --- the test buildings: (file, ground truth by hand) ---------------------------------------
 
-def box_house(path: Path, *, millimetres: bool = True, windows: bool = True) -> dict:
+def box_house(path: Path, *, millimetres: bool = True, windows: bool = True,
+              origin: Vec = (0.0, 0.0, 0.0)) -> dict:
     """10 x 8 m, walls 0.3 m thick and 3 m high on z = 0, a roof slab, no floor slab (an open
-    underside): two 1.2 x 1.5 m windows south, one east, a 1 x 2.1 m door north."""
-    h = IfcHouse(millimetres=millimetres)
+    underside): two 1.2 x 1.5 m windows south, one east, a 1 x 2.1 m door north; ``origin``
+    moves it (a georeferenced model)."""
+    h = IfcHouse(millimetres=millimetres, origin=origin)
     h.storey("ground", 0.0)
     south = h.box("IfcWall", (0, 0, 0), (10, 0.3, 3), name="south")
     north = h.box("IfcWall", (0, 7.7, 0), (10, 8, 3), name="north")
@@ -123,7 +128,8 @@ def box_house(path: Path, *, millimetres: bool = True, windows: bool = True) -> 
         window, door = 3 * 1.2 * 1.5, 1.0 * 2.1
     h.write(path)
     return {"gross": 2 * (10 + 8) * 3.0, "window": window, "door": door, "footprint": 80.0,
-            "outline": [(0, 0), (10, 0), (10, 8), (0, 8)], "facades": 4, "height": 3.2}
+            "outline": [(0, 0), (10, 0), (10, 8), (0, 8)], "facades": 4, "height": 3.2,
+            "origin": origin}
 
 
 def l_shaped_house(path: Path) -> dict:
@@ -161,7 +167,7 @@ def crawl_space_house(path: Path) -> dict:
     box_house(path, millimetres=True)
     h = IfcHouse.__new__(IfcHouse)
     h.file = ifcopenshell.open(str(path))
-    h.scale = 1000.0
+    h.scale, h.origin = 1000.0, np.zeros(3)
     h.body = h.file.by_type("IfcGeometricRepresentationSubContext")[0]
     h.storeys = {"ground": h.file.by_type("IfcBuildingStorey")[0]}
     for lo, hi in (((0, 0, -1), (10, 0.3, 0)), ((0, 7.7, -1), (10, 8, 0)),

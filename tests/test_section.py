@@ -5,8 +5,8 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
-from dataset.section import cross_section_footprint
 from dataset.raycast import Raycaster
+from dataset.section import cross_section_footprint
 
 
 def _footprint(mesh, z):
