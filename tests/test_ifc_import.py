@@ -9,11 +9,11 @@ import json
 
 import numpy as np
 import pytest
-from ifc_models import HOUSES, IfcHouse, box_house
 from shapely.geometry import Polygon
 
 from dataset import generate
 from dataset.classes import NO_FACADE, SemanticClass
+from dataset.examples.ifc_houses import HOUSES, IfcHouse, box_house
 from dataset.footprint import geojson_to_polygon
 from dataset.ifc_classes import read_class_overrides
 from dataset.ifc_import import import_ifc, read_ifc, warning_lines

@@ -1,12 +1,16 @@
-"""Small IFC buildings made on the fly with ``ifcopenshell.api``, with their areas by hand.
+"""Small IFC buildings made with ``ifcopenshell.api``, with their areas by hand.
 
-Every solid is an axis-aligned box (an extruded rectangle, as BIM tools write walls and
-slabs); windows and doors fill openings cut through their wall. Lengths are given in metres
-and written in the file's unit (millimetres or metres).
+``python -m dataset.examples.ifc_houses --out DIR`` writes the five houses of
+:data:`HOUSES` as ``DIR/<name>.ifc`` (the tests build them on the fly). Every solid is an
+axis-aligned box (an extruded rectangle, as BIM tools write walls and slabs); windows and
+doors fill openings cut through their wall. Lengths are given in metres and written in the
+file's unit (millimetres or metres).
 """
 
 from __future__ import annotations
 
+import argparse
+import sys
 from pathlib import Path
 
 import ifcopenshell
@@ -212,3 +216,23 @@ def no_window_house(path: Path) -> dict:
 
 HOUSES = {"box_mm": box_house, "l_shaped": l_shaped_house, "crawl_space": crawl_space_house,
           "curtain_wall": curtain_wall_house, "no_windows": no_window_house}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m dataset.examples.ifc_houses",
+        description="Write the example IFC houses (box in millimetres, L-shaped, crawl space, "
+                    "curtain wall, no windows) into a folder; their areas are in the docstrings.")
+    parser.add_argument("--out", type=Path, required=True, help="folder for <name>.ifc")
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    for name, make in HOUSES.items():
+        expected = make(args.out / f"{name}.ifc")
+        print(f"{args.out / name}.ifc: facade {expected['gross']:.2f} m2, window "
+              f"{expected['window']:.2f} m2, WWR {expected['window'] / expected['gross']:.4f}, "
+              f"footprint {expected['footprint']:.2f} m2")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
