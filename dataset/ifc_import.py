@@ -28,12 +28,14 @@ from dataset.truth import Building
 
 @dataclass(frozen=True)
 class IfcElement:
-    """One imported IFC product: its identity and our class."""
+    """One imported IFC product: its identity, our class and, for a window, its declared
+    OverallWidth x OverallHeight in m² (None if not given)."""
 
     global_id: str
     ifc_type: str
     name: str
     label: SemanticClass
+    declared_area_m2: float | None = None
 
 
 @dataclass(frozen=True)
@@ -106,7 +108,8 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
         if _has_parts(product):
             continue  # a whole whose parts carry the geometry (curtain wall, roof)
         wanted[product.id()] = IfcElement(product.GlobalId, product.is_a(),
-                                          product.Name or "", SemanticClass(label))
+                                          product.Name or "", SemanticClass(label),
+                                          _declared_window_area_m2(product, unit_scale))
     if not wanted:
         raise ValueError(f"{path} has no building element with geometry (walls, slabs, ...)")
 
@@ -198,32 +201,29 @@ def import_ifc(
         "warnings": warnings,
         "skipped": [{"global_id": e.global_id, "type": e.ifc_type, "name": e.name}
                     for e in model.skipped],
-        "windows": _window_areas(path, model, building, element_of_face),
+        "windows": _window_areas(model, building, element_of_face),
     }
     return building
 
 
-def _window_areas(path: Path, model: IfcModel, building: Building, element_of_face: np.ndarray
+def _window_areas(model: IfcModel, building: Building, element_of_face: np.ndarray
                   ) -> list[dict]:
     """Each IfcWindow's declared OverallWidth x OverallHeight beside its measured area (m²):
     the window-class faces of that element that belong to a facade."""
-    import ifcopenshell
-
-    ifc = ifcopenshell.open(str(path))
     mesh = building.mesh
     counted = (mesh.face_facade != NO_FACADE) & (mesh.face_label == SemanticClass.WINDOW)
     measured = np.bincount(element_of_face[counted], weights=mesh.face_areas_m2()[counted],
                            minlength=len(model.elements))
-    rows = []
-    for i, e in enumerate(model.elements):
-        if e.ifc_type not in ("IfcWindow", "IfcWindowStandardCase"):
-            continue
-        product = ifc.by_guid(e.global_id)
-        w, h = product.OverallWidth, product.OverallHeight
-        declared = None if w is None or h is None else float(w * h) * model.unit_scale ** 2
-        rows.append({"global_id": e.global_id, "name": e.name, "declared_area_m2": declared,
-                     "measured_area_m2": float(measured[i])})
-    return rows
+    return [{"global_id": e.global_id, "name": e.name, "declared_area_m2": e.declared_area_m2,
+             "measured_area_m2": float(measured[i])}
+            for i, e in enumerate(model.elements) if e.ifc_type.startswith("IfcWindow")]
+
+
+def _declared_window_area_m2(product, unit_scale: float) -> float | None:
+    if not product.is_a("IfcWindow"):
+        return None
+    w, h = product.OverallWidth, product.OverallHeight
+    return None if w is None or h is None else float(w * h) * unit_scale ** 2
 
 
 def _has_parts(product) -> bool:

@@ -124,23 +124,24 @@ def building_from_mesh(
     mesh, parent = split_at_height(
         LabelledMesh(vertices, faces, mesh.face_label, mesh.face_facade), grade_z
     )
-    is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
-    mesh, touching_parent = split_touching_faces(
-        mesh, is_facade_class & (mesh.triangles_m[:, :, 2].mean(axis=1) > grade_z)
-    )
-    parent = kept[parent[touching_parent]]
-    vertices, faces = mesh.vertices_m, mesh.faces
-
-    areas, normals = mesh.face_areas_m2(), mesh.face_normals()
-    above = mesh.triangles_m[:, :, 2].mean(axis=1) > grade_z
-    is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
-    candidate = is_facade_class & above
+    parent = kept[parent]
+    candidate = _facade_candidates(mesh, grade_z)
     raycaster = Raycaster(mesh)
-    visible = np.zeros(len(faces), dtype=bool)
-    visible[candidate] = escape_fractions(
-        raycaster, mesh.triangles_m[candidate], normals[candidate],
-        rays_per_sample=config.rays_per_sample, offset_m=config.ray_offset_m, ground=True,
-    ) >= config.min_escape_fraction
+    visible = _seen_from_outside(raycaster, candidate, config)
+    # Faces seen from outside that another body's face partly covers: cut them there and
+    # decide the pieces (a hidden face's pieces stay hidden).
+    mesh, touching_parent = split_touching_faces(mesh, visible)
+    if len(touching_parent) != len(visible):
+        parent = parent[touching_parent]
+        piece = np.bincount(touching_parent)[touching_parent] > 1
+        raycaster = Raycaster(mesh)
+        visible = visible[touching_parent] & ~piece
+        visible |= _seen_from_outside(raycaster, piece & _facade_candidates(mesh, grade_z),
+                                      config)
+    vertices, faces = mesh.vertices_m, mesh.faces
+    areas, normals = mesh.face_areas_m2(), mesh.face_normals()
+    is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
+    candidate = _facade_candidates(mesh, grade_z)
     groups = group_facades(
         mesh.triangles_m, normals, areas, visible,
         max_tilt_deg=config.max_tilt_deg,
@@ -185,7 +186,7 @@ def building_from_mesh(
             "offset_m": [float(x) for x in offset],
             "ground_z_m": ground_z,
             "hidden_area_m2": _class_areas(mesh, areas, candidate & ~visible),
-            "below_grade_area_m2": _class_areas(mesh, areas, is_facade_class & ~above),
+            "below_grade_area_m2": _class_areas(mesh, areas, is_facade_class & ~candidate),
             "unassigned_area_m2": _class_areas(
                 mesh, areas, visible & (face_facade == NO_FACADE)
             ),
@@ -195,6 +196,24 @@ def building_from_mesh(
         },
     )
     return Building(mesh=mesh, truth=truth), parent
+
+
+def _facade_candidates(mesh: LabelledMesh, grade_z_m: float) -> np.ndarray:
+    """(F,) bool: wall, window and door faces above the ground."""
+    above = mesh.triangles_m[:, :, 2].mean(axis=1) > grade_z_m
+    return np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES]) & above
+
+
+def _seen_from_outside(raycaster: Raycaster, which: np.ndarray, config: ImportConfig
+                       ) -> np.ndarray:
+    """(F,) bool: faces in ``which`` that enough rays leave (:mod:`dataset.visibility`)."""
+    seen = np.zeros(len(which), dtype=bool)
+    if which.any():
+        seen[which] = escape_fractions(
+            raycaster, raycaster.mesh.triangles_m[which], raycaster.face_normals[which],
+            rays_per_sample=config.rays_per_sample, offset_m=config.ray_offset_m, ground=True,
+        ) >= config.min_escape_fraction
+    return seen
 
 
 def _drop_collapsed_faces(mesh: LabelledMesh) -> tuple[LabelledMesh, np.ndarray]:
