@@ -3,9 +3,11 @@
 BIM solids touch: a wall butts against the side of another at a corner, a window lining
 lies against its reveal. The part of a face covered by a touching body is inside the
 building, the rest may be facade; the visibility test (:mod:`dataset.visibility`) decides a
-face as a whole, so :func:`split_touching_faces` first cuts each face along the outline of
-the opposite-facing coplanar faces that cover it. The pieces are triangulated with shapely's
-constrained Delaunay triangulation; nothing else changes.
+face as a whole, so :func:`split_touching_faces` cuts each face along the outline of the
+opposite-facing coplanar faces that cover it -- and, where two overlapping solids are
+flush on one side, along the earlier solid's coincident face, whose twin must not count
+twice. The pieces are triangulated with shapely's constrained Delaunay triangulation;
+nothing else changes.
 """
 
 from __future__ import annotations
@@ -24,15 +26,20 @@ BOX_TOLERANCE_M = 1e-9  # bounding boxes that overlap by less than this do not t
 
 def split_touching_faces(
     mesh: LabelledMesh, which: np.ndarray
-) -> tuple[LabelledMesh, np.ndarray]:
-    """Cut faces in ``which`` along the outline of the coplanar faces that face them.
+) -> tuple[LabelledMesh, np.ndarray, np.ndarray]:
+    """Cut faces in ``which`` where coplanar faces of other bodies lie on them.
+
+    Two kinds of cover: an *opposite* face (the faces touch: that part is inside the
+    building, and the rays will find it hidden) and, for two overlapping solids flush on
+    one side, an earlier face facing the *same* way (that part is the earlier face's
+    twin and must not count twice).
 
     Parameters
     ----------
     mesh
         The building: faces of touching bodies, z up, metres.
     which : (F,) bool
-        Faces to cut (the facade candidates); any face may cover them.
+        Faces to cut (the facades' candidates); any face may cover them.
 
     Returns
     -------
@@ -41,6 +48,8 @@ def split_touching_faces(
         id and orientation).
     parent : (F',) int64
         Index of each output face's face in the input.
+    twin : (F',) bool
+        Pieces that an earlier same-facing face already covers.
     """
     normals = mesh.face_normals()
     tri = mesh.triangles_m
@@ -53,37 +62,46 @@ def split_touching_faces(
     by_plane: dict[tuple[float, ...], list[int]] = {}
     for j, k in enumerate(map(tuple, keys)):
         by_plane.setdefault(k, []).append(j)
+
+    def overlapping(faces: list[int] | None, i: int) -> np.ndarray:
+        """Those of ``faces`` whose bounding boxes overlap face i's."""
+        f = np.asarray(faces if faces else [], dtype=np.int64)
+        near = np.all((lo[f] < hi[i] - BOX_TOLERANCE_M) & (hi[f] > lo[i] + BOX_TOLERANCE_M)
+                      | (extent[f] < BOX_TOLERANCE_M) | (extent[i] < BOX_TOLERANCE_M), axis=1)
+        return f[near]
+
     new_vertices: list[np.ndarray] = []
     piece_parent: list[int] = []
+    piece_twin: list[bool] = []
     cut = np.zeros(len(tri), dtype=bool)
     for i in np.flatnonzero(which & (np.linalg.norm(normals, axis=1) > 0.5)):
-        opposite = by_plane.get(tuple(-keys[i] + 0.0))
-        if not opposite:
-            continue
-        opposite = np.asarray(opposite)
-        overlap = np.all((lo[opposite] < hi[i] - BOX_TOLERANCE_M)
-                         & (hi[opposite] > lo[i] + BOX_TOLERANCE_M)
-                         | (extent[opposite] < BOX_TOLERANCE_M) | (extent[i] < BOX_TOLERANCE_M),
-                         axis=1)
-        opposite = opposite[overlap]
-        if len(opposite) == 0:
+        opposite = overlapping(by_plane.get(tuple(-keys[i] + 0.0)), i)
+        same = overlapping(by_plane.get(tuple(keys[i])), i)
+        same = same[same < i]
+        if len(opposite) == 0 and len(same) == 0:
             continue
         u, v = basis_u[i], basis_v[i]
         origin = tri[i, 0]
         uv = np.stack([u, v], axis=1)  # (3, 2)
         own = Polygon((tri[i] - origin) @ uv)
-        others = shapely.polygons((tri[opposite] - origin) @ uv)
-        cover = shapely.union_all(others).intersection(own)
-        if cover.area < MIN_PIECE_M2 or own.area - cover.area < MIN_PIECE_M2:
-            continue
+        cover = shapely.union_all(shapely.polygons((tri[opposite] - origin) @ uv)
+                                  ).intersection(own)
+        twin = shapely.union_all(shapely.polygons((tri[same] - origin) @ uv)
+                                 ).intersection(own).difference(cover)
+        rest = own.difference(cover).difference(twin)
+        if twin.area < MIN_PIECE_M2 and min(cover.area, rest.area) < MIN_PIECE_M2:
+            continue  # not covered, or wholly covered by touching faces: the rays decide
         cut[i] = True
-        for part in (cover, own.difference(cover)):
+        for part, is_twin in ((cover, False), (twin, True), (rest, False)):
+            if part.area < MIN_PIECE_M2:
+                continue
             triangles = shapely.get_parts(shapely.constrained_delaunay_triangles(part))
             xy = shapely.get_coordinates(shapely.get_exterior_ring(triangles)).reshape(-1, 4, 2)
             new_vertices.append(origin + xy[:, :3, :1] * u + xy[:, :3, 1:2] * v)  # (T, 3, 3)
             piece_parent.extend([int(i)] * len(xy))
+            piece_twin.extend([is_twin] * len(xy))
     if not cut.any():
-        return mesh, np.arange(len(tri))
+        return mesh, np.arange(len(tri)), np.zeros(len(tri), dtype=bool)
     corners = np.concatenate(new_vertices)
     piece_parent_a = np.asarray(piece_parent, dtype=np.int64)
     # Each piece turns the way its parent does.
@@ -92,10 +110,12 @@ def split_touching_faces(
     corners[flip] = corners[flip][:, ::-1]
     keep = np.flatnonzero(~cut)
     parent = np.concatenate([keep, piece_parent_a])
+    twins = np.concatenate([np.zeros(len(keep), dtype=bool), np.asarray(piece_twin)])
     vertices = np.concatenate([mesh.vertices_m, corners.reshape(-1, 3)])
     pieces = len(mesh.vertices_m) + np.arange(3 * len(corners)).reshape(-1, 3)
     faces = np.concatenate([mesh.faces[keep], pieces])
-    return LabelledMesh(vertices, faces, mesh.face_label[parent], mesh.face_facade[parent]), parent
+    return (LabelledMesh(vertices, faces, mesh.face_label[parent], mesh.face_facade[parent]),
+            parent, twins)
 
 
 def _plane_bases(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -129,15 +129,16 @@ def building_from_mesh(
     raycaster = Raycaster(mesh)
     visible = _seen_from_outside(raycaster, candidate, config)
     # Faces seen from outside that another body's face partly covers: cut them there and
-    # decide the pieces (a hidden face's pieces stay hidden).
-    mesh, touching_parent = split_touching_faces(mesh, visible)
-    if len(touching_parent) != len(visible):
+    # decide the pieces (a hidden face's pieces stay hidden; a twin is not counted).
+    mesh, touching_parent, twin = split_touching_faces(mesh, visible)
+    if len(touching_parent) != len(visible) or twin.any():
         parent = parent[touching_parent]
         piece = np.bincount(touching_parent)[touching_parent] > 1
         raycaster = Raycaster(mesh)
         visible = visible[touching_parent] & ~piece
         visible |= _seen_from_outside(raycaster, piece & _facade_candidates(mesh, grade_z),
                                       config)
+        visible &= ~twin  # counted once, on the earlier solid's face
     vertices, faces = mesh.vertices_m, mesh.faces
     areas, normals = mesh.face_areas_m2(), mesh.face_normals()
     is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
