@@ -8,7 +8,9 @@ facade's depth pixels (:mod:`baselines.facade_mask`).
 When the enclosing quadrilateral is not a rectangle in 3D (a gable facade is a
 pentagon; an occluder can bite a corner off), :func:`upright_rectangle_m`
 gives the facade's bounding rectangle in its plane instead, with vertical sides
-along gravity (known from the camera pose).
+along gravity (known from the camera pose). The facade's own area, for a facade
+that is no rectangle, is its mask's outline put on the plane
+(:func:`outline_area_on_plane_m2`).
 """
 
 from __future__ import annotations
@@ -119,3 +121,42 @@ def image_from_camera_uv(points_m: np.ndarray, intrinsics: Intrinsics) -> np.nda
     """(..., 2) image points of (..., 3) camera-frame points (OpenGL frame, in front)."""
     uv, _ = project_world_to_image(points_m, intrinsics, np.eye(4))
     return uv
+
+
+def outline_area_on_plane_m2(mask: np.ndarray, plane: Plane, intrinsics: Intrinsics) -> float:
+    """Area (m²) on ``plane`` of the region inside a facade mask's outline.
+
+    Each image column of the mask is filled from its top facade pixel to its bottom one
+    (windows set back from the plane, balcony bands and other occluders across the facade
+    do not count as gaps; a gable's or a step's top edge does); every pixel of the filled
+    region is put on the plane by its four corners, and the quadrilaterals' areas are
+    summed (half the cross product of their diagonals).
+
+    Parameters
+    ----------
+    mask : (H, W) bool
+        The facade's pixels.
+
+    Raises
+    ------
+    ViewError
+        If the mask is empty or a pixel corner's ray misses the plane.
+    """
+    m = np.asarray(mask, dtype=bool)
+    below_top = np.maximum.accumulate(m, axis=0)
+    above_bottom = np.maximum.accumulate(m[::-1], axis=0)[::-1]
+    filled = below_top & above_bottom
+    rows, cols = np.nonzero(filled)
+    if len(rows) == 0:
+        raise ViewError("the facade mask is empty")
+    r0, c0 = rows.min(), cols.min()
+    sub = filled[r0:rows.max() + 1, c0:cols.max() + 1]
+    h, w = sub.shape
+    # Pixel (r, c) spans [c, c + 1] x [r, r + 1] in continuous image coordinates.
+    v, u = np.meshgrid(np.arange(h + 1.0) + r0, np.arange(w + 1.0) + c0, indexing="ij")
+    corners = points_on_plane_m(np.stack([u.ravel(), v.ravel()], axis=1), plane, intrinsics)
+    corners = corners.reshape(h + 1, w + 1, 3)
+    d1 = corners[1:, 1:] - corners[:-1, :-1]
+    d2 = corners[1:, :-1] - corners[:-1, 1:]
+    area = 0.5 * np.linalg.norm(np.cross(d1, d2), axis=-1)
+    return float(area[sub].sum())

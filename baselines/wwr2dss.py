@@ -16,8 +16,11 @@ Per view (see each module for the details):
    WWR is window / facade pixels inside the rectangle (:mod:`baselines.rectify`).
 
 Per facade, WWR, L and H are the mean (or median) over its views; facade area
-= L H and window area = WWR L H. Building WWR = sum(WWR_i alpha_i) / sum(alpha_i)
-as in the paper, or with ``weighting="area"`` sum(WWR_i A_i) / sum(A_i).
+= L H, or, when the mask's outline on the plane fills less than
+``min_rectangle_fill`` of L H (a gable, a stepped facade), the outline's area
+(:func:`baselines.backproject.outline_area_on_plane_m2`); window area = WWR x area.
+Building WWR = sum(WWR_i alpha_i) / sum(alpha_i) as in the paper, or with
+``weighting="area"`` sum(WWR_i A_i) / sum(A_i).
 
     python -m baselines.wwr2dss --views ideal --data DIR [--weighting alpha|area] [--out DIR]
 """
@@ -39,6 +42,7 @@ from baselines.backproject import (
     corners_camera_m,
     facade_size_m,
     image_from_camera_uv,
+    outline_area_on_plane_m2,
     upright_rectangle_m,
 )
 from baselines.cli import add_common_arguments, main_guarded, run_scenes
@@ -75,7 +79,9 @@ class Wwr2dssConfig:
     the image border (or outside) means the facade is cut off; the view is
     skipped. ``max_corner_angle_error_deg``: largest deviation from 90 degrees
     of a corner of the back-projected quadrilateral before the upright bounding
-    rectangle replaces it. ``seed``: RANSAC randomness.
+    rectangle replaces it. ``min_rectangle_fill``: a facade whose mask outline covers
+    less than this share of its L x H rectangle is measured by the outline's area
+    (0 keeps L x H always). ``seed``: RANSAC randomness.
     """
 
     weighting: Literal["alpha", "area"] = "alpha"
@@ -86,6 +92,7 @@ class Wwr2dssConfig:
     batch_size: int = 8
     corner_margin_px: float = 1.0
     max_corner_angle_error_deg: float = 5.0
+    min_rectangle_fill: float = 0.95
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -98,6 +105,8 @@ class Wwr2dssConfig:
                              "batch_size >= 1")
         if not 0 < self.max_corner_angle_error_deg <= 90:
             raise ValueError("max_corner_angle_error_deg must be in (0, 90]")
+        if not 0 <= self.min_rectangle_fill <= 1:
+            raise ValueError("min_rectangle_fill must be in [0, 1]")
 
 
 @dataclass(frozen=True)
@@ -107,7 +116,8 @@ class ViewGeometry:
     ``mask`` (H, W) bool; ``corners_uv`` (4, 2) image corners TL, TR, BR, BL;
     ``corners_m`` (4, 3) the same in the camera frame (m); ``corners_from``
     says whether they come from the enclosing quadrilateral or the upright
-    bounding rectangle.
+    bounding rectangle; ``outline_area_m2`` the area inside the mask's outline on
+    the facade plane (NaN where a pixel's ray misses the plane).
     """
 
     view: FacadeView
@@ -117,6 +127,7 @@ class ViewGeometry:
     length_m: float
     height_m: float
     corners_from: Literal["quadrilateral", "upright_rectangle"] = "quadrilateral"
+    outline_area_m2: float = float("nan")
 
 
 def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
@@ -147,7 +158,11 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
         source = "upright_rectangle"
     corners_inside_image(corners, k.width, k.height, config.corner_margin_px)
     length, height = facade_size_m(corners_m)
-    return ViewGeometry(view, mask, corners, corners_m, length, height, source)
+    try:
+        outline = outline_area_on_plane_m2(mask, plane, k)
+    except ViewError:
+        outline = float("nan")
+    return ViewGeometry(view, mask, corners, corners_m, length, height, source, outline)
 
 
 def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
@@ -232,6 +247,11 @@ def _facade_estimate(fid: int, ms: list[tuple[ViewGeometry, float]],
     length = combine_values([g.length_m for g, _ in ms], config.combine)
     height = combine_values([g.height_m for g, _ in ms], config.combine)
     area = length * height
+    outlines = [g.outline_area_m2 for g, _ in ms if np.isfinite(g.outline_area_m2)]
+    if outlines:
+        outline = combine_values(outlines, config.combine)
+        if outline < config.min_rectangle_fill * area:  # a gable, a step: not a rectangle
+            area = outline
     return FacadeEstimate(id=fid, wwr=wwr, window_area_m2=wwr * area, facade_area_m2=area,
                           width_m=length, height_m=height, views_used=len(ms))
 

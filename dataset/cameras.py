@@ -34,7 +34,8 @@ from dataset.render import Raycaster, render_ground_truth
 from dataset.truth import Building
 
 ViewFailure = Literal[
-    "below_ground", "inside_building", "too_close", "not_visible", "touches_border", "too_small"
+    "below_ground", "inside_building", "under_building", "too_close", "not_visible",
+    "touches_border", "too_small",
 ]
 
 
@@ -132,7 +133,8 @@ def orbit_view_failures(
     """Boundary conditions a pose breaks (empty when it meets them all).
 
     Checked on a depth render ``config.check_resolution`` pixels wide: camera at
-    least ``min_camera_height_m`` above the ground and outside the building;
+    least ``min_camera_height_m`` above the ground, outside the building and not under
+    it (a vertical ray up from the camera leaves the mesh);
     building visible, no nearer than ``min_clearance_m``, clear of a border band of
     ``margin`` of the image, covering at least ``min_coverage`` of the pixels.
     """
@@ -143,6 +145,8 @@ def orbit_view_failures(
         failures.append("below_ground")
     if raycaster.contains(eye[None])[0]:
         failures.append("inside_building")
+    elif not raycaster.open_to_sky(eye[None])[0]:
+        failures.append("under_building")  # under a slab, a balcony, an overhang
     small = intrinsics.scaled(config.check_resolution / intrinsics.width)
     depth = render_ground_truth(raycaster, small, pose).depth_z_m
     hit = depth > 0
@@ -310,6 +314,8 @@ def _facade_view_problem(
     eye = pose[:3, 3]
     if raycaster.contains(eye[None])[0]:
         return "camera would be inside the building"
+    if not raycaster.open_to_sky(eye[None])[0]:
+        return "camera would be under the building (a slab, a balcony, an overhang)"
     points = _facade_samples_m(raycaster, patch, config.visibility_samples)
     to_points = points - eye
     _, t = raycaster.first_hit(np.broadcast_to(eye, to_points.shape), to_points)
@@ -369,7 +375,7 @@ def _adjust_orbit(
             return pose, ()
         if "below_ground" in failures:
             elevation = min(elevation + np.deg2rad(5.0), max_elevation)
-        if {"inside_building", "too_close"} & set(failures):
+        if {"inside_building", "under_building", "too_close"} & set(failures):
             radius *= 1.25
         elif "touches_border" in failures:
             radius *= 1.15

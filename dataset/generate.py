@@ -23,6 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.import_config import add_import_arguments
 from dataset.provenance import file_fingerprint
 from dataset.ray_tasks import RayConfig
 from dataset.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
@@ -184,7 +185,8 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
         epilog=(
             "examples: python -m dataset.generate --preset tiny --out data/tiny | "
             "python -m dataset.generate --preset paper --out data/paper --workers 2 | "
-            "python -m dataset.generate --mesh house.ply --out data/mine. "
+            "python -m dataset.generate --mesh house.ply --out data/mine | "
+            "python -m dataset.generate --ifc house.ifc --out data/mine. "
             "Layout and options: docs/rendering.md."
         ),
     )
@@ -193,6 +195,11 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     src.add_argument("--mesh", type=Path, metavar="FILE",
                      help="your labelled mesh (.ply with per-face label, or .obj/.glb with "
                           "class-named parts), metres, z up; see docs/importing.md")
+    src.add_argument("--ifc", type=Path, metavar="FILE",
+                     help="an IFC model (ArchiCAD, Revit, ... export); see docs/importing.md")
+    p.add_argument("--ifc-classes", type=Path, metavar="JSON",
+                   help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
+                        '{"IfcCovering": "wall", "IfcRailing": "skip"}')
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
     p.add_argument("--resolution", type=int, default=d.resolution,
@@ -218,6 +225,7 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_import_arguments(p)  # with --mesh or --ifc
     add_debug_flag(p)
     return p.parse_args(argv)
 
@@ -269,9 +277,9 @@ def _check_resources(args: argparse.Namespace, config: GenerateConfig) -> None:
 
 
 def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
-    from dataset.importer import import_labelled_mesh
+    from dataset.import_source import import_from_args
 
-    building = import_labelled_mesh(args.mesh)
+    building = import_from_args(args)
     check_writable(args.out)
     name = building.truth.id
     _remove_stale_partials(args.out, name)

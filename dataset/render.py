@@ -5,6 +5,9 @@ hit gives the triangle. Embree works in float32, so the hit distance is then
 recomputed in float64 from the hit triangle's plane: depth is exact to float64
 rounding, not to Embree's float32 tolerance.
 
+The world's ground is the plane z = 0 (DESIGN.md): a surface hit below it is underground
+and the pixel shows the ground (an imported building's foundations are not seen).
+
 The RGB image (:func:`render_rgb`) shades the same hits; its look lives in
 :mod:`dataset.shading`.
 """
@@ -17,7 +20,11 @@ import numpy as np
 
 from dataset.camera import Intrinsics, rays_world
 from dataset.mesh import LabelledMesh
+from dataset.raycast import Raycaster
 from dataset.shading import RgbConfig, shade
+
+GROUND_Z_M = 0.0
+GROUND_TOLERANCE_M = 1e-6  # hits this far below the ground still count (float round-off)
 
 __all__ = [
     "GroundTruthImages",
@@ -27,129 +34,6 @@ __all__ = [
     "render_rgb",
     "render_view",
 ]
-
-# Below this |n . d| a ray grazes its triangle's plane and the plane solve is
-# ill-conditioned; Embree's own distance is used there instead.
-_GRAZING_COS = 1e-9
-
-
-class Raycaster:
-    """First-hit and occlusion queries on a :class:`LabelledMesh` (Embree BVH, built once).
-
-    Vertices are shifted to the mesh's bounding-box centre before the float32
-    conversion, so precision does not depend on where the building stands.
-
-    Attributes
-    ----------
-    mesh : LabelledMesh
-    bounds_m : (2, 3) float64
-        Lowest and highest vertex coordinates (world metres).
-    face_normals : (F, 3) float64
-        Outward unit normal of every face.
-
-    Raises
-    ------
-    ValueError
-        If the mesh has no faces or the Embree backend (``embreex``) is missing.
-    """
-
-    def __init__(self, mesh: LabelledMesh):
-        if not isinstance(mesh, LabelledMesh):
-            raise ValueError(f"Raycaster needs a dataset.mesh.LabelledMesh, got {type(mesh)}")
-        if len(mesh.faces) == 0:
-            raise ValueError("cannot render a mesh without faces")
-        try:
-            from embreex import rtcore_scene
-            from embreex.mesh_construction import TriangleMesh
-        except ImportError as exc:
-            raise ValueError(
-                "the renderer needs Intel Embree through the embreex package: pip install embreex"
-            ) from exc
-        self.mesh = mesh
-        lo, hi = mesh.vertices_m.min(axis=0), mesh.vertices_m.max(axis=0)
-        self.bounds_m = np.stack([lo, hi])
-        self._shift_m = 0.5 * (lo + hi)
-        self._scene = rtcore_scene.EmbreeScene()
-        TriangleMesh(
-            self._scene,
-            (mesh.vertices_m - self._shift_m).astype(np.float32),
-            mesh.faces.astype(np.int32),
-        )
-        self.face_normals = mesh.face_normals()
-        self._plane_offset_m = np.einsum("ij,ij->i", self.face_normals, mesh.triangles_m[:, 0])
-
-    def first_hit(self, origins_m: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Nearest triangle along each ray.
-
-        Parameters
-        ----------
-        origins_m : (N, 3) float
-            Ray origins, world metres.
-        dirs : (N, 3) float
-            Ray directions (any non-zero length); distances are in units of ``dirs``.
-
-        Returns
-        -------
-        face : (N,) int64
-            Index of the hit face, -1 where the ray misses.
-        t : (N,) float64
-            Hit parameter (point = origin + t * dir), ``inf`` where the ray misses.
-        """
-        o, d = _check_rays(origins_m, dirs)
-        hit = self._scene.run(self._to_embree(o), d.astype(np.float32), output=1)
-        face = hit["primID"].astype(np.int64)
-        t = np.full(len(o), np.inf)
-        ok = face >= 0
-        f = face[ok]
-        n = self.face_normals[f]
-        n_dot_d = np.einsum("ij,ij->i", n, d[ok])
-        n_dot_o = np.einsum("ij,ij->i", n, o[ok])
-        exact = np.abs(n_dot_d) > _GRAZING_COS * np.linalg.norm(d[ok], axis=1)
-        t_ok = hit["tfar"][ok].astype(np.float64)
-        t_ok[exact] = (self._plane_offset_m[f[exact]] - n_dot_o[exact]) / n_dot_d[exact]
-        t[ok] = t_ok
-        return face, t
-
-    def occluded(
-        self, origins_m: np.ndarray, dirs: np.ndarray, t_max: np.ndarray | float = np.inf
-    ) -> np.ndarray:
-        """(N,) bool: whether anything lies along each ray within ``t_max`` (units of ``dirs``)."""
-        o, d = _check_rays(origins_m, dirs)
-        t_far = np.broadcast_to(np.asarray(t_max, dtype=np.float32), (len(o),)).copy()
-        res = self._scene.run(
-            self._to_embree(o), d.astype(np.float32), dists=t_far, query="OCCLUDED"
-        )
-        return res >= 0
-
-    def contains(self, points_m: np.ndarray) -> np.ndarray:
-        """(N,) bool: whether points lie inside the (closed or bottom-open) mesh.
-
-        A point is inside when most rays cast from it in 14 directions first hit
-        a face from behind; rays that escape (an open bottom) do not vote.
-        """
-        p = np.asarray(points_m, dtype=np.float64).reshape(-1, 3)
-        dirs = _PROBE_DIRS
-        o = np.repeat(p, len(dirs), axis=0)
-        d = np.tile(dirs, (len(p), 1))
-        face, _ = self.first_hit(o, d)
-        facing = np.einsum("ij,ij->i", self.face_normals[np.maximum(face, 0)], d)
-        back = ((face >= 0) & (facing > 0)).reshape(len(p), -1).sum(axis=1)
-        front = ((face >= 0) & (facing <= 0)).reshape(len(p), -1).sum(axis=1)
-        return back > front
-
-    def _to_embree(self, origins_m: np.ndarray) -> np.ndarray:
-        return (origins_m - self._shift_m).astype(np.float32)
-
-
-def _probe_dirs() -> np.ndarray:
-    axes = np.eye(3)
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    # Slightly skewed so that no probe runs exactly along a wall or through an edge.
-    d = np.concatenate([axes, -axes, corners / np.sqrt(3)]) + np.array([1e-3, 2e-3, 3e-3])
-    return d / np.linalg.norm(d, axis=1, keepdims=True)
-
-
-_PROBE_DIRS = _probe_dirs()
 
 
 @dataclass(frozen=True)
@@ -287,19 +171,11 @@ def _cast_view(
     origins, dirs = origins.reshape(-1, 3), dirs.reshape(-1, 3)
     face, t = rc.first_hit(origins, dirs)
     # A triangle the camera sits in front of can only be hit at t > 0; guard rounding.
-    behind = (face >= 0) & (t <= 0)
+    # Below z = 0 is the ground: what an imported building has below grade is not seen.
+    hit_z = np.where(face >= 0, origins[:, 2] + np.where(face >= 0, t, 0.0) * dirs[:, 2], 0.0)
+    behind = (face >= 0) & ((t <= 0) | (hit_z < GROUND_Z_M - GROUND_TOLERANCE_M))
     face[behind], t[behind] = -1, np.inf
     return _ViewHits(rc, origins, dirs, face, t, (intrinsics.height, intrinsics.width))
-
-
-def _check_rays(origins_m: np.ndarray, dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    o = np.asarray(origins_m, dtype=np.float64)
-    d = np.asarray(dirs, dtype=np.float64)
-    if o.ndim != 2 or o.shape[1] != 3 or o.shape != d.shape:
-        raise ValueError(
-            f"ray origins and directions must both be (N, 3), got {o.shape} and {d.shape}"
-        )
-    return o, d
 
 
 def _to_srgb8(rgb_linear: np.ndarray, exposure: float) -> np.ndarray:

@@ -1,7 +1,8 @@
 """A closed mesh's footprint: its horizontal cross-section at one height, as a shapely polygon.
 
 The section's segments are snapped to :data:`SNAP_GRID_M` and polygonised; each face of
-that planar arrangement is solid if a point inside it is inside the mesh (ray parity).
+that planar arrangement is solid if a point inside it is inside the building (the one
+inside rule, :meth:`dataset.raycast.Raycaster.contains`: the union of the mesh's bodies).
 The footprint is the solid's outline: every hole in the solid is filled (rooms between
 exterior and interior walls of a BIM model, the insides of partitions) unless it is open
 to the sky -- a vertical ray from it leaves the mesh -- which makes it a courtyard, kept
@@ -15,25 +16,20 @@ import shapely
 from shapely.geometry import MultiLineString, MultiPolygon, Polygon
 from shapely.ops import polygonize, unary_union
 
-from dataset.visibility import open_to_sky
+from dataset.raycast import Raycaster
 
 SNAP_GRID_M = 1e-6  # joins segment ends that float round-off left a few nm apart
 
 
-def cross_section_footprint(
-    vertices_m: np.ndarray, faces: np.ndarray, z_m: float, intersector
-) -> Polygon | MultiPolygon:
-    """Footprint of a closed mesh from its cross-section at height ``z_m``.
+def cross_section_footprint(raycaster: Raycaster, z_m: float) -> Polygon | MultiPolygon:
+    """Footprint of a building mesh from its cross-section at height ``z_m``.
 
     Parameters
     ----------
-    vertices_m : (V, 3) float
-    faces : (F, 3) int
-        A closed (watertight) triangle mesh, world frame, z up.
+    raycaster
+        Over the building's mesh: closed bodies (touching or overlapping), world frame, z up.
     z_m
         Section height in metres; choose one that no horizontal face lies in.
-    intersector
-        :func:`dataset.visibility.embree_intersector` of the same mesh.
 
     Returns
     -------
@@ -46,7 +42,7 @@ def cross_section_footprint(
     """
     import trimesh
 
-    mesh = trimesh.Trimesh(vertices_m, faces, process=False)
+    mesh = trimesh.Trimesh(raycaster.mesh.vertices_m, raycaster.mesh.faces, process=False)
     segments = trimesh.intersections.mesh_plane(mesh, [0.0, 0.0, 1.0], [0.0, 0.0, z_m])
     if len(segments) == 0:
         raise ValueError(
@@ -60,14 +56,14 @@ def cross_section_footprint(
             f"the section at z = {z_m:.3f} m has no closed outline; is the mesh closed?"
         )
     inside_pts = np.array([[*p.representative_point().coords[0], z_m] for p in regions])
-    solid = unary_union([p for p, inside in zip(regions, _contains(intersector, inside_pts))
+    solid = unary_union([p for p, inside in zip(regions, raycaster.contains(inside_pts))
                          if inside])
     if solid.is_empty:
         raise ValueError(f"the section at z = {z_m:.3f} m holds no solid; is the mesh inside out?")
-    return _fill_roofed_holes(solid, z_m, intersector)
+    return _fill_roofed_holes(solid, z_m, raycaster)
 
 
-def _fill_roofed_holes(solid, z_m: float, intersector) -> Polygon | MultiPolygon:
+def _fill_roofed_holes(solid, z_m: float, raycaster: Raycaster) -> Polygon | MultiPolygon:
     parts = list(solid.geoms) if isinstance(solid, MultiPolygon) else [solid]
     filled = []
     for part in parts:
@@ -77,7 +73,7 @@ def _fill_roofed_holes(solid, z_m: float, intersector) -> Polygon | MultiPolygon
             if free.is_empty:
                 continue
             point = free.representative_point()
-            if open_to_sky(intersector, np.array([[point.x, point.y, z_m]]))[0]:
+            if raycaster.open_to_sky(np.array([[point.x, point.y, z_m]]))[0]:
                 holes.append(ring)
         filled.append(Polygon(part.exterior, holes))
     # Drop the collinear vertices that every triangle edge crossing the plane leaves behind.
@@ -86,7 +82,3 @@ def _fill_roofed_holes(solid, z_m: float, intersector) -> Polygon | MultiPolygon
         return footprint.geoms[0]
     return footprint
 
-
-def _contains(intersector, points_m: np.ndarray) -> np.ndarray:
-    """(N,) bool: points inside the closed mesh (odd number of ray crossings, trimesh)."""
-    return np.asarray(intersector.contains_points(points_m), dtype=bool)

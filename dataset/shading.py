@@ -21,7 +21,7 @@ import numpy as np
 from dataset.classes import NO_FACADE, SemanticClass
 
 if TYPE_CHECKING:
-    from dataset.render import Raycaster
+    from dataset.raycast import Raycaster
 
 WallMaterial = Literal["random", "plaster", "brick"]
 
@@ -181,7 +181,7 @@ def shade(
     origins_m, dirs : (N, 3) float
         The rays (``dirs`` any length; hit point = origin + t * dir).
     face : (N,) int, t : (N,) float
-        First hits as returned by :meth:`dataset.render.Raycaster.first_hit`.
+        First hits as returned by :meth:`dataset.raycast.Raycaster.first_hit`.
     """
     look = sample_look(seed, config)
     d_unit = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)

@@ -1,17 +1,24 @@
-"""Which faces of a closed mesh can be seen from outside, by embree ray casting.
+"""Which faces of a building can be seen from outside, by ray casting (:mod:`dataset.raycast`).
 
 A face is sampled at :data:`SAMPLE_BARYCENTRIC` points, each nudged ``offset_m`` off the
 surface along the face normal; from each sample, rays leave along a fixed set of
 directions spread over the outward hemisphere. The fraction of rays that hit nothing
 is the face's escape fraction: 0 for faces enclosed by the mesh (inner sides of walls,
-partitions, ceilings of a BIM export), and typically >= 0.3 for an outside wall (half
-the hemisphere points down and, with no ground in the mesh, escapes).
+partitions, ceilings of a BIM export), and typically >= 0.3 for an outside wall. With a
+ground height, every ray that points downwards counts as stopped by the ground, so an
+open underside (no floor slab, a crawl space) does not let the inner sides of the walls
+see out; an outside wall then keeps about half its rays.
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from tqdm import tqdm
+
+if TYPE_CHECKING:
+    from dataset.raycast import Raycaster
 
 SAMPLE_BARYCENTRIC = np.array(
     [[1 / 3, 1 / 3, 1 / 3], [0.6, 0.2, 0.2], [0.2, 0.6, 0.2], [0.2, 0.2, 0.6]]
@@ -23,32 +30,6 @@ starts clear of the neighbouring face.
 """
 MIN_RAY_COSINE = 0.1  # no ray within ~6 deg of the face plane: it would graze coplanar neighbours
 RAYS_PER_BATCH = 1 << 20  # bounds memory: ~100 MB of float64 per batch
-
-
-def embree_intersector(vertices_m: np.ndarray, faces: np.ndarray):
-    """An embree ``trimesh.ray.ray_pyembree.RayMeshIntersector`` over a triangle mesh.
-
-    Parameters
-    ----------
-    vertices_m : (V, 3) float
-    faces : (F, 3) int
-
-    Raises
-    ------
-    ValueError
-        If embree (the ``embreex`` package) is not installed.
-    """
-    import trimesh
-
-    try:
-        from trimesh.ray.ray_pyembree import RayMeshIntersector
-    except ImportError as exc:
-        raise ValueError(
-            "visibility needs embree ray casting, which is not installed: "
-            "run `pip install embreex` (trimesh then uses it automatically)"
-        ) from exc
-    mesh = trimesh.Trimesh(vertices_m, faces, process=False)
-    return RayMeshIntersector(mesh)
 
 
 def hemisphere_directions(count: int) -> np.ndarray:
@@ -66,20 +47,21 @@ def hemisphere_directions(count: int) -> np.ndarray:
 
 
 def escape_fractions(
-    intersector,
+    raycaster: Raycaster,
     triangles_m: np.ndarray,
     normals: np.ndarray,
     *,
     rays_per_sample: int,
     offset_m: float,
+    ground: bool = False,
     show_progress: bool = True,
 ) -> np.ndarray:
     """Fraction of outward rays from each face that leave the mesh without a hit.
 
     Parameters
     ----------
-    intersector
-        From :func:`embree_intersector`, over the whole mesh.
+    raycaster
+        :class:`dataset.raycast.Raycaster` over the whole mesh.
     triangles_m : (F, 3, 3) float
         The faces to test (any subset of the mesh).
     normals : (F, 3) float
@@ -88,6 +70,8 @@ def escape_fractions(
         Directions per sample point (:func:`hemisphere_directions`).
     offset_m
         How far off the surface the rays start, above embree's float32 precision.
+    ground
+        Whether the faces stand above a ground: rays pointing downwards never escape.
 
     Returns
     -------
@@ -115,22 +99,13 @@ def escape_fractions(
         hi = min(lo + faces_per_batch, n_faces)
         o = np.broadcast_to(starts[lo:hi, :, None, :], (hi - lo, starts.shape[1], len(local), 3))
         d = np.broadcast_to(dirs[lo:hi, None, :, :], o.shape)
-        hit = intersector.intersects_any(o.reshape(-1, 3), d.reshape(-1, 3))
+        d = d.reshape(-1, 3)
+        hit = raycaster.occluded(o.reshape(-1, 3), d)
+        if ground:
+            hit |= d[:, 2] < 0
         escaped[lo:hi] = 1.0 - hit.reshape(hi - lo, -1).mean(axis=1)
     result[valid] = escaped
     return result
-
-
-def open_to_sky(intersector, points_m: np.ndarray) -> np.ndarray:
-    """(N,) bool: does a vertical ray up from each point leave the mesh without a hit?
-
-    Parameters
-    ----------
-    points_m : (N, 3) float
-    """
-    p = np.asarray(points_m, dtype=np.float64).reshape(-1, 3)
-    up = np.broadcast_to(np.array([0.0, 0.0, 1.0]), p.shape)
-    return ~np.asarray(intersector.intersects_any(p, up), dtype=bool)
 
 
 def _to_world(local: np.ndarray, normals: np.ndarray) -> np.ndarray:

@@ -198,6 +198,15 @@ def test_gable_facade_gets_its_upright_bounding_rectangle():
     assert g.length_m == pytest.approx(10.0, rel=L_TOL)
     assert g.height_m == pytest.approx(9.0, rel=L_TOL)
     assert wwr == pytest.approx(true_wwr(10.0, 6.0, wins, gable_m=3.0), abs=WWR_TOL)
+    # Its area is the outline's, 10 x 6 + 10 x 3 / 2 = 75 m², not the rectangle's 90 m².
+    assert g.outline_area_m2 == pytest.approx(75.0, rel=L_TOL)
+
+
+def test_rectangular_facade_outline_fills_its_rectangle():
+    pose = facade_pose(L_M, H_M, distance_m=15.0, azimuth_deg=35.0)
+    labels, depth = render_facade(K, pose, **FACADE)
+    g, _, _ = _measure(labels, depth, pose, K)
+    assert g.outline_area_m2 == pytest.approx(L_M * H_M, rel=L_TOL)
 
 
 def test_balcony_bands_across_the_facade_do_not_cut_it_into_strips():

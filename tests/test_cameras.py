@@ -67,6 +67,14 @@ def test_orbit_views_are_deterministic(box_building, box_raycaster):
     assert not np.allclose(np.array(a), np.array(c))
 
 
+def test_camera_under_a_slab_is_refused():
+    slab = trimesh.creation.box(bounds=[[-5.0, -5.0, 3.0], [5.0, 5.0, 3.3]])
+    rc = Raycaster.from_triangles(slab.vertices, slab.faces)
+    failures = orbit_view_failures(rc, K, look_at([0.0, 0.0, 1.6], [0.0, 4.0, 3.0]),
+                                   OrbitConfig())
+    assert "under_building" in failures and "inside_building" not in failures
+
+
 def test_failures_are_reported(box_raycaster):
     config = OrbitConfig()
     assert "inside_building" in orbit_view_failures(

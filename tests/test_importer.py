@@ -272,3 +272,48 @@ def test_agrees_with_the_generators_exact_truth(tmp_path):
         assert mine.window_area_m2 == pytest.approx(f.window_area_m2, rel=REL, abs=1e-9)
         assert mine.facade_area_m2 == pytest.approx(f.facade_area_m2, rel=REL)
     assert _iou(geojson_to_polygon(t.footprint), geojson_to_polygon(g.footprint)) >= 0.999
+
+
+def test_overlapping_boxes_give_the_union_footprint(tmp_path):
+    # Two closed boxes that overlap, one mesh without repairs: inside is their union.
+    a = trimesh.creation.box(bounds=[[0, 0, 0], [10, 8, 6]])
+    b = trimesh.creation.box(bounds=[[6, 4, 0], [14, 10, 4]])
+    both = trimesh.util.concatenate([a, b])
+    n = len(both.faces)
+    write_labelled_ply(tmp_path / "two.ply", LabelledMesh(
+        both.vertices, both.faces, np.full(n, WALL), np.zeros(n, dtype=np.int32)))
+    t = import_labelled_mesh(tmp_path / "two.ply").truth
+    union = Polygon([(0, 0), (10, 0), (10, 4), (14, 4), (14, 10), (6, 10), (6, 8), (0, 8)])
+    assert t.footprint_area_m2 == pytest.approx(union.area, rel=1e-9)  # 80 + 48 - 16
+    shift = np.asarray(t.extra["offset_m"][:2])
+    fp = geojson_to_polygon(t.footprint)
+    fp = Polygon(np.asarray(fp.exterior.coords) - shift)
+    assert _iou(fp, union) >= 0.999
+
+
+def test_ground_level_cuts_faces_and_nothing_below_counts(tmp_path, bim_mesh):
+    # The example building with its ground 1.2 m up: the lowest 1.2 m is underground.
+    write_labelled_ply(tmp_path / "bim.ply", bim_mesh)
+    t = import_labelled_mesh(tmp_path / "bim.ply", config=ImportConfig(ground_z_m=1.2)).truth
+    assert t.facade_area_m2 == pytest.approx(2 * (12 + 8) * (6.3 - 1.2), rel=REL)
+    assert t.door_area_m2 == pytest.approx(1.0 * (2.4 - 1.2), rel=REL)  # door: z 0.3 to 2.4
+    assert t.height_m == pytest.approx(6.3 - 1.2, rel=REL)
+    assert t.extra["below_grade_area_m2"]["door"] > 0.0
+    assert t.footprint_area_m2 == pytest.approx(96.0, rel=REL)
+
+
+def test_generate_mesh_takes_every_import_option(tmp_path):
+    from dataclasses import fields
+
+    from dataset.generate import _parse_args
+    from dataset.import_config import import_config_from_args
+
+    args = _parse_args(["--mesh", "m.ply", "--out", str(tmp_path), "--ground-z", "0.5",
+                        "--up-axis", "y", "--footprint-height-m", "0.2", "--keep-position",
+                        "--rays-per-sample", "8", "--min-facade-width-m", "0.7"])
+    config = import_config_from_args(args)
+    assert (config.ground_z_m, config.up_axis, config.footprint_height_m, config.recentre,
+            config.rays_per_sample, config.min_facade_width_m) == (0.5, "y", 0.2, False, 8, 0.7)
+    defaults = import_config_from_args(_parse_args(["--mesh", "m.ply", "--out", str(tmp_path)]))
+    assert defaults == ImportConfig()
+    assert all(hasattr(defaults, f.name) for f in fields(ImportConfig))

@@ -5,14 +5,12 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
+from dataset.raycast import Raycaster
 from dataset.section import cross_section_footprint
-from dataset.visibility import embree_intersector
 
 
 def _footprint(mesh, z):
-    return cross_section_footprint(
-        mesh.vertices, mesh.faces, z, embree_intersector(mesh.vertices, mesh.faces)
-    )
+    return cross_section_footprint(Raycaster.from_triangles(mesh.vertices, mesh.faces), z)
 
 
 def test_hollow_box_with_roof_is_filled():

@@ -4,13 +4,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.visibility import (
-    MIN_RAY_COSINE,
-    embree_intersector,
-    escape_fractions,
-    hemisphere_directions,
-    open_to_sky,
-)
+from dataset.raycast import Raycaster
+from dataset.visibility import MIN_RAY_COSINE, escape_fractions, hemisphere_directions
 
 
 def _normals(tri):
@@ -28,33 +23,44 @@ def test_hemisphere_directions_are_unit_and_above_the_plane():
         hemisphere_directions(0)
 
 
-def test_intersector_is_embree():
-    box = trimesh.creation.box()
-    assert type(embree_intersector(box.vertices, box.faces)).__module__.endswith("ray_pyembree")
-
-
 def test_convex_box_sees_everything_and_a_nested_box_nothing():
     outer = trimesh.creation.box([10.0, 8.0, 6.0])
     inner = trimesh.creation.box([2.0, 2.0, 2.0])
     mesh = trimesh.util.concatenate([outer, inner])
     tri = mesh.triangles
-    f = escape_fractions(embree_intersector(mesh.vertices, mesh.faces), tri, _normals(tri),
+    f = escape_fractions(Raycaster.from_triangles(mesh.vertices, mesh.faces), tri, _normals(tri),
                          rays_per_sample=16, offset_m=1e-3)
     np.testing.assert_array_equal(f[: len(outer.faces)], 1.0)  # convex: every ray escapes
     np.testing.assert_array_equal(f[len(outer.faces):], 0.0)  # enclosed: none does
-    degenerate = escape_fractions(embree_intersector(mesh.vertices, mesh.faces), tri[:1],
+    degenerate = escape_fractions(Raycaster.from_triangles(mesh.vertices, mesh.faces), tri[:1],
                                   np.zeros((1, 3)), rays_per_sample=4, offset_m=1e-3)
     np.testing.assert_array_equal(degenerate, 0.0)
 
 
 def test_open_to_sky():
     box = trimesh.creation.box([2.0, 2.0, 2.0])
-    ix = embree_intersector(box.vertices + [0, 0, 5], box.faces)
-    np.testing.assert_array_equal(open_to_sky(ix, [[0, 0, 0], [3, 0, 0]]), [False, True])
+    rc = Raycaster.from_triangles(box.vertices + [0, 0, 5], box.faces)
+    np.testing.assert_array_equal(rc.open_to_sky([[0, 0, 0], [3, 0, 0]]), [False, True])
+
+
+def test_ground_stops_downward_rays():
+    # An open-bottomed box (walls and roof, no floor): the inner wall sides see out through
+    # the bottom unless the ground stops the rays that point down.
+    box = trimesh.creation.box([4.0, 4.0, 3.0])
+    box.apply_translation([0, 0, 1.5])
+    walls_and_roof = box.faces[box.face_normals[:, 2] > -0.5]
+    inner = walls_and_roof[:, ::-1]  # the same faces seen from inside
+    tri = box.vertices[inner]
+    rc = Raycaster.from_triangles(box.vertices, walls_and_roof)
+    open_below = escape_fractions(rc, tri, _normals(tri), rays_per_sample=16, offset_m=1e-3)
+    grounded = escape_fractions(rc, tri, _normals(tri), rays_per_sample=16, offset_m=1e-3,
+                                ground=True)
+    assert open_below[np.abs(_normals(tri)[:, 2]) < 0.5].min() > 0.02
+    np.testing.assert_array_equal(grounded, 0.0)
 
 
 def test_bad_shapes_are_refused():
     box = trimesh.creation.box()
     with pytest.raises(ValueError, match=r"\(F, 3, 3\)"):
-        escape_fractions(embree_intersector(box.vertices, box.faces), np.zeros((2, 3)),
+        escape_fractions(Raycaster.from_triangles(box.vertices, box.faces), np.zeros((2, 3)),
                          np.zeros((2, 3)), rays_per_sample=4, offset_m=1e-3)
