@@ -24,7 +24,6 @@ from tqdm import tqdm
 
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.import_config import add_import_arguments
-from dataset.provenance import file_fingerprint
 from dataset.ray_tasks import RayConfig
 from dataset.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
 from dataset.scene_writer import (
@@ -277,14 +276,14 @@ def _check_resources(args: argparse.Namespace, config: GenerateConfig) -> None:
 
 
 def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
-    from dataset.import_source import import_from_args
+    from dataset.import_source import import_from_args, import_inputs
 
     building = import_from_args(args)
     check_writable(args.out)
     name = building.truth.id
     _remove_stale_partials(args.out, name)
     scene_dir = args.out / name
-    inputs = {"mesh": file_fingerprint(args.mesh)}
+    inputs = import_inputs(args)
     changes = scene_changes(scene_dir, config, args.seed, inputs)
     if not changes:
         return scene_dir

@@ -8,9 +8,23 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import asdict
+from typing import Any
 
 from dataset.import_config import import_config_from_args
+from dataset.provenance import file_fingerprint
 from dataset.truth import Building
+
+
+def import_inputs(args: argparse.Namespace) -> dict[str, Any]:
+    """What a scene imported from ``args`` was made from, for its provenance record: the
+    fingerprints of the source file (and of the class overrides) and the import options."""
+    source = args.mesh if getattr(args, "ifc", None) is None else args.ifc
+    inputs: dict[str, Any] = {"source": file_fingerprint(source),
+                              "import": asdict(import_config_from_args(args))}
+    if getattr(args, "ifc_classes", None) is not None:
+        inputs["classes"] = file_fingerprint(args.ifc_classes)
+    return inputs
 
 
 def import_from_args(args: argparse.Namespace) -> Building:
