@@ -21,11 +21,13 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
+from dataset.degrade.spec import DEGRADATIONS, parse_specs
 from dataset.device import resolve_device
 from dataset.results import code_version
 from dataset.truth import BuildingTruth, read_building
 from metrics.aggregate import aggregate_by_family
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark, ensure_benchmark
+from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import (
     NO_TRUTH_FAMILY,
     BuildingErrors,
@@ -49,6 +51,12 @@ from metrics.report import (
     per_facade_table,
     table2_errors,
     table3_footprint_iou,
+)
+from metrics.robustness import (
+    ROBUSTNESS_NEURAL3D_MINUTES,
+    RobustnessStudy,
+    robustness_table,
+    run_study,
 )
 from metrics.runner import MethodSpec, Outcome, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -264,9 +272,10 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,
                         help="folder for tables, plots, provenance (default: <data>-compare)")
-    parser.add_argument("--neural3d-minutes", type=float, default=Neural3dBudget.minutes,
+    parser.add_argument("--neural3d-minutes", type=float,
                         help="training time limit per building for neural3d, minutes "
-                        f"(default: {Neural3dBudget.minutes})")
+                        f"(default: {Neural3dBudget.minutes}; {ROBUSTNESS_NEURAL3D_MINUTES} in "
+                        "the robustness study)")
     parser.add_argument("--neural3d-preset", default=Neural3dBudget.preset,
                         choices=("paper", "fast", "tiny"), help="neural3d training preset")
     parser.add_argument("--neural3d-resolution", type=int,
@@ -275,6 +284,20 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         f"{DefaultBenchmark.neural3d_resolution})")
     parser.add_argument("--device", default="cpu",
                         help="torch device for neural3d: cpu or cuda (default: cpu)")
+    parser.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
+                        help="compare on degraded inputs (truth unchanged): "
+                        f"{', '.join(DEGRADATIONS)}; see dataset/degrade/spec.py. Degraded "
+                        "scenes are cached in <data>-degraded/, results go to "
+                        "<results>/degraded/, outputs to <out>-<key>")
+    parser.add_argument("--degrade-seed", type=int, default=0,
+                        help="seed of the degradations (default: 0)")
+    parser.add_argument("--robustness", action="store_true",
+                        help="run the robustness study (mask noise, occluders, pose and depth "
+                        "noise at three severities each; results in <results>/robustness, "
+                        "table and plot in <out>/robustness)")
+    parser.add_argument("--robustness-neural3d", choices=("all", "max"), default="all",
+                        help="robustness study: neural3d at every severity or only at the "
+                        "highest of each degradation (default: all)")
     parser.add_argument("--no-run", action="store_true",
                         help="only read existing result files; never run a method")
     return parser.parse_args(argv)
@@ -289,8 +312,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         resolve_device(args.device)
         default = DefaultBenchmark() if args.data is None else None
         resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
+        minutes = args.neural3d_minutes or (ROBUSTNESS_NEURAL3D_MINUTES if args.robustness
+                                            else Neural3dBudget.minutes)
         budget = Neural3dBudget(
-            preset=args.neural3d_preset, minutes=args.neural3d_minutes, resolution=resolution,
+            preset=args.neural3d_preset, minutes=minutes, resolution=resolution,
             eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
         )
         if default is not None:
@@ -298,10 +323,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         data = (ensure_benchmark(default) if default is not None else args.data).resolve()
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
+        if args.robustness:
+            study = RobustnessStudy(seed=args.degrade_seed,
+                                    neural3d_levels=args.robustness_neural3d)
+            rows = run_study(data, results / "robustness", out / "robustness",
+                             lambda r: method_specs(methods, views, r, neural3d=budget), study,
+                             compare)
+            print(to_text(robustness_table(rows)))
+            print(f"wrote robustness.csv/.md/.png to {out / 'robustness'}")
+            return 0
+        if args.degrade:
+            degradation = parse_specs(args.degrade, seed=args.degrade_seed)
+            run = degraded_run(data, results, out, degradation)
+            data, results, out = run.data, run.results, run.out
         if args.no_run:
             specs = read_only_specs(methods, views)
         else:
             specs = method_specs(methods, views, results, neural3d=budget)
+        if args.degrade:
+            specs = with_degradation(specs, degradation)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
         comparison = compare(data, specs, results, out, allow_run=not args.no_run,
                              command=f"python -m metrics.compare {argv_text}".strip())
