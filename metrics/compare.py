@@ -57,6 +57,7 @@ from metrics.robustness import (
     RobustnessStudy,
     robustness_table,
     run_study,
+    study_budget,
 )
 from metrics.runner import MethodSpec, Outcome, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -295,9 +296,9 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         help="run the robustness study (mask noise, occluders, pose and depth "
                         "noise at three severities each; results in <results>/robustness, "
                         "table and plot in <out>/robustness)")
-    parser.add_argument("--robustness-neural3d", choices=("all", "max"), default="all",
+    parser.add_argument("--robustness-neural3d", choices=("all", "max"), default="max",
                         help="robustness study: neural3d at every severity or only at the "
-                        "highest of each degradation (default: all)")
+                        "highest of each degradation (default: max)")
     parser.add_argument("--no-run", action="store_true",
                         help="only read existing result files; never run a method")
     return parser.parse_args(argv)
@@ -312,10 +313,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         resolve_device(args.device)
         default = DefaultBenchmark() if args.data is None else None
         resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
-        minutes = args.neural3d_minutes or (ROBUSTNESS_NEURAL3D_MINUTES if args.robustness
-                                            else Neural3dBudget.minutes)
         budget = Neural3dBudget(
-            preset=args.neural3d_preset, minutes=minutes, resolution=resolution,
+            preset=args.neural3d_preset,
+            minutes=Neural3dBudget.minutes if args.neural3d_minutes is None
+            else args.neural3d_minutes, resolution=resolution,
             eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
         )
         if default is not None:
@@ -324,6 +325,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
         if args.robustness:
+            budget = study_budget(budget, args.neural3d_minutes)
             study = RobustnessStudy(seed=args.degrade_seed,
                                     neural3d_levels=args.robustness_neural3d)
             rows = run_study(data, results / "robustness", out / "robustness",

@@ -33,7 +33,7 @@ def plot_robustness(rows: Sequence[RobustnessRow], stem: str | Path,
     series = sorted({(r.method, r.protocol) for r in rows},
                     key=lambda s: (method_rank(s[0]), protocol_rank(s[1])))
     fig = Figure(figsize=(3.4 * len(degradations), 3.4), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(1, len(degradations), sharey=True))
+    axes = np.atleast_1d(fig.subplots(1, len(degradations)))
     for ax, name in zip(axes, degradations):
         for (method, protocol), marker in zip(series, "osD^v<>"):
             pts = sorted((r.severity, getattr(r, attr)) for r in rows
