@@ -22,12 +22,14 @@ from pathlib import Path
 
 from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.degrade.spec import DEGRADATIONS, parse_specs
 from dataset.device import resolve_device
 from dataset.ray_tasks import RayConfig
 from dataset.results import code_version
 from dataset.truth import BuildingTruth, read_building
 from metrics.aggregate import aggregate_by_family
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark, ensure_benchmark
+from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import (
     NO_TRUTH_FAMILY,
     BuildingErrors,
@@ -54,6 +56,7 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
+from metrics.robustness import RobustnessStudy, robustness_table, run_study, study_budget
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
 
@@ -299,6 +302,20 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         f"{DefaultBenchmark.neural3d_resolution})")
     parser.add_argument("--device", default="cpu",
                         help="torch device for neural3d: cpu or cuda (default: cpu)")
+    parser.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
+                        help="compare on degraded inputs (truth unchanged): "
+                        f"{', '.join(DEGRADATIONS)}; see dataset/degrade/spec.py. Degraded "
+                        "scenes are cached in <data>-degraded/, results go to "
+                        "<results>/degraded/, outputs to <out>-<key>")
+    parser.add_argument("--degrade-seed", type=int, default=0,
+                        help="seed of the degradations (default: 0)")
+    parser.add_argument("--robustness", action="store_true",
+                        help="run the robustness study (mask noise, occluders, pose and depth "
+                        "noise at three severities each; results in <results>/robustness, "
+                        "table and plot in <out>/robustness)")
+    parser.add_argument("--robustness-neural3d", choices=("all", "max"), default="max",
+                        help="robustness study: neural3d at every severity or only at the "
+                        "highest of each degradation (default: max)")
     parser.add_argument("--no-run", action="store_true",
                         help="only read existing result files; never run a method (results "
                         "made by other code or settings are marked stale)")
@@ -346,7 +363,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         out = args.out or data.with_name(f"{data.name}-compare")
         check_output_folder(results, "--results")
         check_output_folder(out, "--out")
+        if args.robustness:
+            budget = study_budget(budget)
+            study = RobustnessStudy(seed=args.degrade_seed,
+                                    neural3d_levels=args.robustness_neural3d)
+            rows = run_study(data, results / "robustness", out / "robustness",
+                             lambda r: method_specs(methods, views, r, neural3d=budget), study,
+                             compare)
+            print(to_text(robustness_table(rows)))
+            print(f"wrote robustness.csv/.md/.png to {out / 'robustness'}")
+            return 0
+        if args.degrade:
+            degradation = parse_specs(args.degrade, seed=args.degrade_seed)
+            run = degraded_run(data, results, out, degradation)
+            data, results, out = run.data, run.results, run.out
         specs = method_specs(methods, views, results, neural3d=budget)
+        if args.degrade:
+            specs = with_degradation(specs, degradation)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
         comparison = compare(data, specs, results, out, allow_run=not args.no_run,
                              reuse_stale=args.reuse_stale,
