@@ -9,6 +9,7 @@ import json
 import pytest
 
 from dataset.degrade.spec import parse_specs
+from dataset.provenance import make_provenance, provenance_changes
 from dataset.results import read_result
 from metrics.compare import main
 from metrics.degraded import CONFIG_KEY, with_degradation
@@ -16,7 +17,7 @@ from metrics.errors import BuildingErrors
 from metrics.report import read_building_errors_csv
 from metrics.robustness import RobustnessStudy, robustness_table, summarise
 from metrics.robustness_plot import plot_robustness
-from metrics.runner import MethodSpec, config_matches
+from metrics.runner import MethodSpec
 
 
 def _row(scene: str, method: str, ape: float | None, status: str = "ok") -> BuildingErrors:
@@ -58,9 +59,12 @@ def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
     record = [{"name": "pose", "severity": 0.5, "seed": 0}]
     assert degraded.config == {"a": 1, CONFIG_KEY: record}
     # A clean result is never reused for a degraded run, nor one of another severity.
-    assert not config_matches(degraded.config, {"a": 1})
-    assert not config_matches(degraded.config, {"a": 1, CONFIG_KEY: [
-        {"name": "pose", "severity": 1.0, "seed": 0}]})
+    def record(config):
+        return make_provenance(config, modules=("dataset.wwr",), inputs={})
+
+    assert provenance_changes(record({"a": 1}), record(degraded.config))
+    assert provenance_changes(record({"a": 1, CONFIG_KEY: [
+        {"name": "pose", "severity": 1.0, "seed": 0}]}), record(degraded.config))
 
 
 def test_compare_degrade_runs_on_a_cached_copy_against_the_original_truth(tiny_benchmark,
