@@ -14,11 +14,12 @@ from typing import Literal
 import numpy as np
 
 from dataset.camera import Intrinsics
+from dataset.protocols import VIEW_PROTOCOLS, ViewProtocol
 from dataset.scene import Frame, Scene
 from dataset.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
 
-Protocol = Literal["ideal", "multi"]
-PROTOCOLS: tuple[str, ...] = ("ideal", "multi")
+Protocol = ViewProtocol  # the 2D methods' protocols (dataset.protocols)
+PROTOCOLS: tuple[str, ...] = VIEW_PROTOCOLS
 
 
 class ViewError(ValueError):

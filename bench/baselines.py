@@ -45,6 +45,7 @@ from baselines.wwr2dss import (  # noqa: E402
     run_2dss,
 )
 from dataset.atomic import write_text_atomic  # noqa: E402
+from dataset.protocols import VIEW_PROTOCOLS  # noqa: E402
 from dataset.scene import Scene, read_scene  # noqa: E402
 from metrics.aggregate import aggregate_by_family  # noqa: E402
 from metrics.errors import building_errors, failed_building  # noqa: E402
@@ -52,7 +53,7 @@ from metrics.report import table2_errors  # noqa: E402
 from metrics.tables import to_markdown  # noqa: E402
 
 SPEED_SIZE = 512
-PROTOCOLS = ("ideal", "multi")
+PROTOCOLS = VIEW_PROTOCOLS
 
 
 def speed_section(scenes: list[Scene], repeat: int) -> str:

@@ -31,6 +31,7 @@ from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
 from dataset.images import write_depth_m, write_labels  # noqa: E402
 from dataset.mesh import read_labelled_ply  # noqa: E402
+from dataset.protocols import VIEW_PROTOCOLS  # noqa: E402
 from dataset.render import Raycaster, render_ground_truth  # noqa: E402
 from dataset.scene import Frame, Scene, read_scene, write_transforms  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
@@ -58,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", type=Path, required=True, help="folder of scene folders")
     parser.add_argument("--family", default="skyscraper", help="building type (building.json)")
-    parser.add_argument("--views", choices=("ideal", "multi"), default="ideal")
+    parser.add_argument("--views", choices=VIEW_PROTOCOLS, default="ideal")
     parser.add_argument("--factors", default="1,2", help="resolution factors, e.g. 1,2,4")
     parser.add_argument("--max-rectified-px", type=int, default=Wwr2dssConfig.max_rectified_px,
                         help="2D-SS's cap on the rectangle's longer side (raise it for factors "

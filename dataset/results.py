@@ -9,15 +9,20 @@ from __future__ import annotations
 import json
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from dataset.atomic import write_json_atomic
+from dataset.protocols import VIEW_PROTOCOLS
 from dataset.provenance import Provenance, code_version
 
 __all__ = ["FacadeEstimate", "MethodResult", "code_version", "read_result", "result_filename",
            "write_result"]
 
 RESULT_SCHEMA_VERSION = 1
+FacadeIdentity = Literal["truth_id", "geometry"]
+"""How a result's facades relate to the truth's: ``truth_id``, its ids are the truth's
+(methods run on views that carry facade ids); ``geometry``, it numbers its own facades
+and gives each a ``normal`` and ``centre_m`` to be matched by (:mod:`metrics.facade_match`)."""
 
 
 @dataclass(frozen=True)
@@ -58,12 +63,12 @@ class MethodResult:
     methods that do not estimate one. ``config`` is the method's full config;
     ``code_version`` the git commit (or package version) that produced it.
     ``config`` is kept as it reads back from JSON (tuples become lists), so a
-    result equals itself after a write and a read.
-
-    ``provenance`` is the record the comparison keys its cache by
-    (:mod:`dataset.provenance`); ``steps`` the training/optimisation steps a
-    method with a step budget ran (``None`` for the others); ``cut_short`` is
-    true when a safety limit (a wall-clock cap) stopped it before its budget.
+    result equals itself after a write and a read. ``provenance`` is the full
+    record of what made it (:mod:`dataset.provenance`; the runner attaches it,
+    and compares it to decide reuse). ``steps`` is the number of optimisation
+    steps an iterative method took (``None`` for the others); ``cut_short``
+    says a safety time cap stopped it before its step budget.
+    ``facade_identity`` says how its facades are matched to the truth's.
     """
 
     scene: str
@@ -81,6 +86,7 @@ class MethodResult:
     steps: int | None = None
     cut_short: bool = False
     provenance: Provenance | None = None
+    facade_identity: FacadeIdentity = "truth_id"
     schema_version: int = RESULT_SCHEMA_VERSION
 
     def __post_init__(self) -> None:
@@ -94,13 +100,16 @@ class MethodResult:
 
     @staticmethod
     def from_json_dict(d: dict[str, Any]) -> MethodResult:
-        record = d.get("provenance")
         return MethodResult(
             **{
                 **d,
                 "facades": tuple(FacadeEstimate.from_json_dict(f) for f in d.get("facades", ())),
                 "warnings": tuple(d.get("warnings", ())),
-                "provenance": None if record is None else Provenance.from_json_dict(record),
+                # Files written before the field existed: ideal/multi results carry truth ids.
+                "facade_identity": d.get("facade_identity") or (
+                    "truth_id" if d.get("protocol") in VIEW_PROTOCOLS else "geometry"),
+                "provenance": None if d.get("provenance") is None
+                else Provenance.from_json_dict(d["provenance"]),
             }
         )
 

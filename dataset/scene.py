@@ -19,7 +19,7 @@ from dataset.classes import CLASS_NAMES
 from dataset.scene_validation import validate_scene
 from dataset.truth import BuildingTruth, read_building
 
-Split = Literal["train", "eval", "ideal", "multi"]
+Split = Literal["train", "eval", "ideal", "multi"]  # eval + the protocols (dataset.protocols)
 SPLITS: tuple[str, ...] = ("train", "eval", "ideal", "multi")
 DEFAULT_DEPTH_UNIT_M = 0.001  # 16-bit depth PNG in millimetres: up to 65.5 m
 

@@ -8,12 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dataset.protocols import PROTOCOLS
 from dataset.truth import BUILDING_TYPES
 from metrics.errors import BuildingErrors
 
 ALL_FAMILIES = "all"  # the family label of the row that pools every family
 METHOD_ORDER = ("2D-S", "2D-SS", "neural3d")
-PROTOCOL_ORDER = ("ideal", "multi", "train")
+PROTOCOL_ORDER = PROTOCOLS
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,6 @@ Status = Literal["ok", "failed"]
 CUT_SHORT = "cut short"  # mark: a safety time cap stopped the run before its step budget
 STALE = "stale"  # mark: made by other code or settings, kept with --reuse-stale
 NO_TRUTH_FAMILY = "unknown"  # family of a scene without building.json (a user's photos)
-FACADE_PROTOCOLS = ("ideal", "multi")  # protocols whose facade ids are the truth's ids
 LEFT_OUT_FACADE_ID = 0  # facade id of a row for an estimate that faces no truth facade
 
 
@@ -209,7 +208,7 @@ def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[Fa
     if truth is None:
         return ()
     base = (result.scene, truth.type, result.method, result.protocol)
-    if result.protocol in FACADE_PROTOCOLS:
+    if result.facade_identity == "truth_id":
         estimates, left_out = result.facades, ()
     elif has_facade_geometry(result.facades):
         try:

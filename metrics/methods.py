@@ -12,14 +12,14 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from dataset.protocols import TRAIN_PROTOCOL, VIEW_PROTOCOLS
 from dataset.ray_tasks import TaskResources
 from dataset.scene import read_scene
 from metrics.runner import MethodSpec
 
 MethodName = Literal["2D-S", "2D-SS", "neural3d"]
 METHODS: tuple[str, ...] = ("2D-S", "2D-SS", "neural3d")
-VIEW_PROTOCOLS: tuple[str, ...] = ("ideal", "multi")
-NEURAL3D_PROTOCOL = "train"
+NEURAL3D_PROTOCOL = TRAIN_PROTOCOL
 NEURAL3D_RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
 NEURAL3D_EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
 # What the results depend on, for their provenance records (dataset.provenance).

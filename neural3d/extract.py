@@ -151,6 +151,7 @@ def measure_field(
         scene=trained.scene_name, method=METHOD, protocol=PROTOCOL, wwr=m.wwr,
         window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
         footprint=footprint, config=asdict(config), code_version=code_version(),
+        facade_identity="geometry",
         wall_time_s=time.perf_counter() - start, warnings=tuple(warnings),
     )
     return result, mesh

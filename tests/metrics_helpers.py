@@ -10,6 +10,7 @@ from pathlib import Path
 from shapely.geometry import box
 
 from dataset.footprint import polygon_to_geojson
+from dataset.protocols import VIEW_PROTOCOLS
 from dataset.results import FacadeEstimate, MethodResult, write_result
 from dataset.truth import BuildingTruth, FacadeTruth, write_building
 
@@ -54,6 +55,7 @@ def make_result(
         scene=scene, method=method, protocol=protocol, wwr=wwr, window_area_m2=window_m2,
         facade_area_m2=facade_m2, facades=facades, footprint=footprint,
         config={"hand_made": True}, code_version="test", wall_time_s=1.0,
+        facade_identity="truth_id" if protocol in VIEW_PROTOCOLS else "geometry",
     )
 
 

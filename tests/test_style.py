@@ -1,6 +1,6 @@
 """The code passes ruff (the project's lint configuration in pyproject.toml)."""
 
-import shutil
+import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -11,8 +11,9 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def test_ruff_clean():
-    if shutil.which("ruff") is None:
-        pytest.fail("ruff is not installed: run `bash scripts/setup.sh`")
+    # The ruff of the running Python, whatever the PATH says.
+    if importlib.util.find_spec("ruff") is None:
+        pytest.fail(f"ruff is not installed for {sys.executable}: run `bash scripts/setup.sh`")
     out = subprocess.run(
         [sys.executable, "-m", "ruff", "check", "."], cwd=ROOT, capture_output=True, text=True
     )
