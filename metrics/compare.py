@@ -45,6 +45,7 @@ from metrics.methods import (
     VIEW_PROTOCOLS,
     Neural3dBudget,
     debug_images_2dss,
+    list_methods,
     method_specs,
     neural3d_extract_dir,
 )
@@ -322,6 +323,9 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--reuse-stale", action="store_true",
                         help="keep stored results made by other code or settings instead of "
                         "recomputing them; the tables mark them 'stale'")
+    parser.add_argument("--list-methods", action="store_true",
+                        help="list the built-in methods and those installed through the "
+                        "envelope_bench.methods entry point group, then exit")
     parser.add_argument("--explain", nargs=2, metavar=("SCENE", "METHOD"),
                         help="print the full provenance record of one scene's result(s) of one "
                         "method, and whether the current code would reuse it; runs nothing")
@@ -338,6 +342,9 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = _parse_args(argv)
+    if args.list_methods:
+        print("\n".join(list_methods()))
+        return 0
 
     def body() -> int:
         start = time.perf_counter()

@@ -12,6 +12,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from dataset.method import Method, installed_methods
 from dataset.protocols import TRAIN_PROTOCOL, VIEW_PROTOCOLS
 from dataset.ray_tasks import TaskResources
 from dataset.scene import read_scene
@@ -22,10 +23,7 @@ METHODS: tuple[str, ...] = ("2D-S", "2D-SS", "neural3d")
 NEURAL3D_PROTOCOL = TRAIN_PROTOCOL
 NEURAL3D_RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
 NEURAL3D_EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
-# What the results depend on, for their provenance records (dataset.provenance).
-BASELINE_CODE = ("dataset", "baselines")
-BASELINE_LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless", "scipy",
-                      "scikit-image", "shapely", "pillow")
+# What neural3d's results depend on, for their provenance records (dataset.provenance).
 NEURAL3D_CODE = ("dataset", "neural3d")
 NEURAL3D_LIBRARIES = ("numpy", "torch", "scipy", "scikit-image", "shapely", "trimesh", "pillow")
 
@@ -70,50 +68,81 @@ def method_specs(
     *,
     neural3d: Neural3dBudget = Neural3dBudget(),
 ) -> list[MethodSpec]:
-    """Specs of the named methods; 2D methods run on ``views``, neural3d on its train views.
+    """Specs of the named methods; view methods run on ``views``, neural3d on its train views.
+
+    Names other than the built-in ones are looked up among the installed
+    plugins (entry point group ``envelope_bench.methods``, :mod:`dataset.method`).
 
     Raises
     ------
     ValueError
         If a method name or a views protocol is unknown.
     """
-    _check_names(names, views)
+    plugins = _check_names(names, views)
     builders = {
         "2D-S": lambda: spec_2ds(views),
         "2D-SS": lambda: spec_2dss(views),
         "neural3d": lambda: spec_neural3d(results_dir / NEURAL3D_RUNS_FOLDER, neural3d),
     }
-    return [builders[name]() for name in names]
+    return [builders[name]() if name in builders else spec_from_method(plugins[name], views)
+            for name in names]
+
+
+def spec_from_method(method: Method, views: tuple[str, ...]) -> MethodSpec:
+    """The spec of a :class:`~dataset.method.Method` run with its default config.
+
+    It runs on the protocols it declares: of the view protocols, those in
+    ``views``; others (``train``) always.
+    """
+    config = method.config_type()
+    protocols = tuple(p for p in method.protocols if p not in VIEW_PROTOCOLS or p in views)
+
+    def run(scene_dir: Path, protocol: str):
+        return method.run(read_scene(scene_dir), protocol, config)
+
+    resources = TaskResources(cpus=1.0, gpus=1.0 if method.resources == "gpu" else 0.0)
+    return MethodSpec(method.name, protocols, _config_dict(config), run,
+                      has_footprint=method.has_footprint, resources=resources,
+                      code=("dataset", *method.packages), libraries=method.libraries)
+
+
+def list_methods() -> list[str]:
+    """One line per available method: name, inputs, protocols, resources, where it comes from."""
+    lines = []
+    for name in METHODS:
+        lines.append(f"{name:10s} built-in   {_BUILT_IN_SUMMARY[name]}")
+    for name, m in installed_methods().items():
+        if name in METHODS:
+            continue
+        lines.append(f"{name:10s} plugin     inputs {','.join(m.inputs)}; protocols "
+                     f"{','.join(m.protocols)}; {m.resources}"
+                     + (f"; {m.description}" if m.description else ""))
+    return lines
+
+
+_BUILT_IN_SUMMARY = {
+    "2D-S": "inputs semantics,depth,poses; protocols ideal,multi; cpu",
+    "2D-SS": "inputs rgb,semantics,depth,poses; protocols ideal,multi; cpu",
+    "neural3d": "inputs rgb,semantics,depth,poses; protocols train; cpu or gpu (--device)",
+}
 
 
 def spec_2ds(views: tuple[str, ...]) -> MethodSpec:
-    """2D-S with its default config (``baselines.wwr2ds``)."""
+    """2D-S with its default config (``baselines.methods.METHOD_2DS``)."""
     try:
-        from baselines.wwr2ds import Wwr2dsConfig, run_2ds
+        from baselines.methods import METHOD_2DS
     except ImportError as exc:
         return _unavailable("2D-S", views, exc)
-    config = Wwr2dsConfig()
-
-    def run(scene_dir: Path, protocol: str):
-        return run_2ds(read_scene(scene_dir), protocol, config)
-
-    return MethodSpec("2D-S", views, _config_dict(config), run, code=BASELINE_CODE,
-                      libraries=BASELINE_LIBRARIES)
+    return spec_from_method(METHOD_2DS, views)
 
 
 def spec_2dss(views: tuple[str, ...]) -> MethodSpec:
-    """2D-SS with its default config (``baselines.wwr2dss``)."""
+    """2D-SS with its default config (``baselines.methods.METHOD_2DSS``)."""
     try:
-        from baselines.wwr2dss import Wwr2dssConfig, run_2dss
+        from baselines.methods import METHOD_2DSS
     except ImportError as exc:
         return _unavailable("2D-SS", views, exc)
-    config = Wwr2dssConfig()
-
-    def run(scene_dir: Path, protocol: str):
-        return run_2dss(read_scene(scene_dir), protocol, config)
-
-    return MethodSpec("2D-SS", views, _config_dict(config), run, code=BASELINE_CODE,
-                      libraries=BASELINE_LIBRARIES)
+    return spec_from_method(METHOD_2DSS, views)
 
 
 def debug_images_2dss(scene_dir: Path, protocol: str, debug_dir: Path) -> None:
@@ -193,15 +222,20 @@ def neural3d_extract_dir(results_dir: Path, scene: str) -> Path:
     return results_dir / NEURAL3D_RUNS_FOLDER / scene / NEURAL3D_EXTRACT_FOLDER
 
 
-def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> None:
+def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> dict[str, Method]:
+    """Check the names and views; returns the installed plugins (loaded only when needed)."""
     if not names:
         raise ValueError(f"no method given; choose from {', '.join(METHODS)}")
-    for name in names:
-        if name not in METHODS:
-            raise ValueError(f"unknown method {name!r}; choose from {', '.join(METHODS)}")
     for view in views:
         if view not in VIEW_PROTOCOLS:
             raise ValueError(f"unknown views {view!r}; choose from {', '.join(VIEW_PROTOCOLS)}")
+    plugins = installed_methods() if any(n not in METHODS for n in names) else {}
+    for name in names:
+        if name not in METHODS and name not in plugins:
+            known = ", ".join((*METHODS, *sorted(plugins)))
+            raise ValueError(f"unknown method {name!r}; choose from {known} "
+                             "(`--list-methods` lists the installed ones)")
+    return plugins
 
 
 def _config_dict(config: Any) -> dict[str, Any]:

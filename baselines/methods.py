@@ -1,0 +1,21 @@
+"""2D-S and 2D-SS as benchmark methods (:class:`dataset.method.Method`)."""
+
+from __future__ import annotations
+
+from baselines.wwr2ds import Wwr2dsConfig, run_2ds
+from baselines.wwr2dss import Wwr2dssConfig, run_2dss
+from dataset.method import Method
+from dataset.protocols import VIEW_PROTOCOLS
+
+LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")
+
+METHOD_2DS = Method(
+    name="2D-S", inputs=("semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
+    config_type=Wwr2dsConfig, run=run_2ds, packages=("baselines",), libraries=LIBRARIES,
+    description="per-view window/facade pixel ratio of the semantic mask (Szczesniak et al.)",
+)
+METHOD_2DSS = Method(
+    name="2D-SS", inputs=("rgb", "semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
+    config_type=Wwr2dssConfig, run=run_2dss, packages=("baselines",), libraries=LIBRARIES,
+    description="facade plane by RANSAC, rectified facade, WWR in the rectified mask",
+)

@@ -1,0 +1,88 @@
+"""The method interface: what a method declares, and how external packages register one.
+
+A :class:`Method` has a name, the inputs it reads, the protocols it runs on,
+the resources it needs, its config type and ``run(scene, protocol, config) ->
+MethodResult``. 2D-S and 2D-SS are declared in :mod:`baselines.methods`;
+``metrics`` runs every method through this record (``metrics.methods``).
+
+Another package adds a method without touching this repository by exposing a
+:class:`Method` (or a zero-argument callable returning one) under the entry
+point group ``envelope_bench.methods``, e.g. in its ``pyproject.toml``::
+
+    [project.entry-points."envelope_bench.methods"]
+    my-wwr = "my_package.bench:METHOD"
+
+``python -m metrics.compare --list-methods`` lists what is installed.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, Literal
+
+from dataset.protocols import Protocol
+from dataset.results import MethodResult
+from dataset.scene import Scene
+
+ENTRY_POINT_GROUP = "envelope_bench.methods"
+Input = Literal["rgb", "semantics", "depth", "poses"]
+Resource = Literal["cpu", "gpu"]
+RunMethod = Callable[[Scene, str, Any], MethodResult]
+"""(scene, protocol, config) -> the method's result for that scene; may raise."""
+
+
+@dataclass(frozen=True)
+class Method:
+    """A benchmark method.
+
+    ``inputs``: what it reads from a scene (never the truth). ``protocols``:
+    the view protocols it runs on (``dataset.protocols``). ``resources``:
+    ``"gpu"`` if it needs one. ``config_type``: a frozen dataclass whose default
+    instance is the config it runs with (its fields go into the result's
+    provenance). ``packages``: importable packages whose source its results
+    depend on, besides ``dataset`` (a change there recomputes its results);
+    ``libraries``: distributions whose versions matter. ``has_footprint``:
+    whether it estimates a footprint (it is then listed in Table 3).
+    """
+
+    name: str
+    inputs: tuple[Input, ...]
+    protocols: tuple[Protocol, ...]
+    config_type: type
+    run: RunMethod
+    resources: Resource = "cpu"
+    has_footprint: bool = False
+    packages: tuple[str, ...] = ()
+    libraries: tuple[str, ...] = ("numpy",)
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.name or "__" in self.name or "/" in self.name:
+            raise ValueError(f"method name {self.name!r} must be non-empty, without '__' or '/'")
+        if not self.protocols:
+            raise ValueError(f"method {self.name} runs on no protocol")
+
+
+def installed_methods(warn: Callable[[str], None] | None = None) -> dict[str, Method]:
+    """Methods registered under ``envelope_bench.methods``, by name.
+
+    An entry point that fails to load or is not a :class:`Method` is skipped
+    with a line to ``warn`` (stderr by default); the others load.
+    """
+    warn = warn or (lambda line: print(line, file=sys.stderr))
+    found: dict[str, Method] = {}
+    for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+        try:
+            obj = ep.load()
+            method = obj if isinstance(obj, Method) else obj()
+        except Exception as exc:  # a broken plugin must not stop the benchmark
+            warn(f"method plugin {ep.name} ({ep.value}) skipped: {type(exc).__name__}: {exc}")
+            continue
+        if not isinstance(method, Method):
+            warn(f"method plugin {ep.name} ({ep.value}) skipped: not a dataset.method.Method")
+            continue
+        found.setdefault(method.name, method)
+    return found
