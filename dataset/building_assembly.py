@@ -128,7 +128,8 @@ def assemble_building(
         facades=facades,
         name=name,
         seed=seed,
-        extra={**(extra or {}), "facade_outlines_m": facade_outlines_m(walls)},
+        extra=dict(extra or {}),
+        facade_outlines_m=facade_outlines_m(walls),
     )
     faces = [face for w in walls for face in wall_faces(w)] + list(other_faces)
     return Building(mesh=triangulate_faces(faces), truth=truth)

@@ -43,7 +43,15 @@ class FacadeTruth:
 
 @dataclass(frozen=True)
 class BuildingTruth:
-    """Whole-building ground truth; areas in m², lengths in m, world x/y for the footprint."""
+    """Whole-building ground truth; areas in m², lengths in m, world x/y for the footprint.
+
+    ``facade_outlines_m``: per facade id, the world-frame outline of each of its
+    walls, (n, 3) corners in metres counter-clockwise seen from outside (a
+    planar facade has one, a faceted curved facade one per facet); empty when
+    unknown (e.g. imported meshes). Evaluation matches a method's own facades
+    to the truth's by them. Older files kept them in ``extra["facade_outlines_m"]``:
+    they are moved here when read (and when built that way).
+    """
 
     id: str
     type: BuildingType
@@ -60,6 +68,20 @@ class BuildingTruth:
     name: str = ""
     seed: int | None = None
     extra: dict[str, Any] = field(default_factory=dict)
+    facade_outlines_m: dict[int, tuple[tuple[tuple[float, float, float], ...], ...]] = field(
+        default_factory=dict)
+
+    def __post_init__(self) -> None:
+        outlines = self.facade_outlines_m
+        if not outlines and "facade_outlines_m" in self.extra:
+            outlines = self.extra["facade_outlines_m"]
+            object.__setattr__(self, "extra", {k: v for k, v in self.extra.items()
+                                               if k != "facade_outlines_m"})
+        object.__setattr__(self, "facade_outlines_m", {
+            int(fid): tuple(tuple(tuple(float(x) for x in corner) for corner in outline)
+                            for outline in walls)
+            for fid, walls in outlines.items()
+        })
 
     def facade(self, facade_id: int) -> FacadeTruth:
         """The facade with id ``facade_id``."""
@@ -73,6 +95,10 @@ class BuildingTruth:
         d["facades"] = [asdict(f) for f in self.facades]
         for f in d["facades"]:
             f["normal"] = list(f["normal"])
+        d["facade_outlines_m"] = {
+            str(fid): [[list(corner) for corner in outline] for outline in walls]
+            for fid, walls in sorted(self.facade_outlines_m.items())
+        }
         return d
 
     @staticmethod

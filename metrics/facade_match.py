@@ -6,7 +6,7 @@ with the truth by where they are, from each estimate's ``normal`` and
 ``centre_m`` (world frame, :class:`dataset.results.FacadeEstimate`) and the
 truth's ``building.json``:
 
-1. the truth's walls are the outlines in ``extra["facade_outlines_m"]`` (one
+1. the truth's walls are the outlines in ``BuildingTruth.facade_outlines_m`` (one
    polygon per wall, one per facet of a curved wall); an estimate may go to a
    wall whose normal agrees within ``MAX_NORMAL_ANGLE_DEG`` (45 degrees) with its own;
 2. of those, it goes to the facade of the wall nearest to its centre (3D
@@ -67,7 +67,7 @@ def match_facades(estimates: Sequence[FacadeEstimate], truth: BuildingTruth) -> 
     """
     owners: dict[int, list[FacadeEstimate]] = {}
     left_out: list[tuple[int, str]] = []
-    outlines = truth.extra.get("facade_outlines_m", {}) if truth.extra else {}
+    outlines = truth.facade_outlines_m
     for est in estimates:
         if est.normal is None or est.centre_m is None:
             raise ValueError(f"estimated facade {est.id} has no normal or centre_m; only "
@@ -114,7 +114,7 @@ def _owner(est: FacadeEstimate, truth: BuildingTruth, outlines: dict) -> int | N
     for t in truth.facades:
         # each wall (facet) of a facade with outlines faces its own way: a curved
         # facade's segments agree with their facets, not with the mean normal
-        walls = [np.asarray(w, dtype=np.float64) for w in outlines.get(str(t.id), [])]
+        walls = [np.asarray(w, dtype=np.float64) for w in outlines.get(t.id, ())]
         candidates = [(distance_to_outline_m(est.centre_m, w), float(n @ _newell_normal(w)))
                       for w in walls]
         if not walls:

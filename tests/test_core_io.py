@@ -184,3 +184,18 @@ def test_footprint_geojson_round_trip():
     assert Polygon(geo["coordinates"][0]).exterior.is_ccw
     with pytest.raises(ValueError, match="GeoJSON Polygon"):
         geojson_to_polygon({"type": "Point", "coordinates": [0, 0]})
+
+
+def test_facade_outlines_are_a_typed_field_and_old_files_still_read(tmp_path):
+    from metrics_helpers import make_truth
+
+    from dataset.truth import BuildingTruth, read_building, write_building
+
+    outline = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [0.0, 0.0, 3.0]]
+    truth = replace(make_truth("a"), facade_outlines_m={1: [outline]})
+    assert truth.facade_outlines_m[1][0][2] == (4.0, 0.0, 3.0)
+    write_building(tmp_path / "building.json", truth)
+    assert read_building(tmp_path / "building.json") == truth
+    old = truth.to_json_dict()
+    old["extra"] = {"facade_outlines_m": old.pop("facade_outlines_m")}
+    assert BuildingTruth.from_json_dict(old) == truth

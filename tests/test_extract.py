@@ -73,7 +73,7 @@ def _box_truth():
             wall_area_m2=7 * width, door_area_m2=0.0, facade_area_m2=10 * width, wwr=0.3))
         outlines[str(i + 1)] = [[[x0, y0, 0.0], [x1, y1, 0.0], [x1, y1, 10.0], [x0, y0, 10.0]]]
     return replace(make_truth("analytic_box"), facades=tuple(facades),
-                   extra={"facade_outlines_m": outlines})
+                   facade_outlines_m=outlines)
 
 
 CONFIG = ExtractConfig(resolution=96, footprint_cell_m=0.1)

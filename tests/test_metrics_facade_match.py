@@ -101,7 +101,7 @@ def test_curved_wall_segments_merge_into_one_facade():
                        facade_area_m2=area, wwr=0.3, curved=True)
     (recipe,) = [r for r in preset_recipes("tiny") if r.id == "tiny_skyscraper"]
     truth = replace(build_building(recipe).truth, facades=(wall,),
-                    extra={"facade_outlines_m": {"1": outlines}})
+                    facade_outlines_m={1: outlines})
     match = match_facades(estimates, truth)
     assert len(estimates) > 1 and match.left_out == ()
     (whole,) = match.facades
