@@ -41,9 +41,7 @@ from neural3d.data import (  # noqa: E402
     load_frames,
     scene_normalisation,
 )
-from neural3d.losses import total_loss  # noqa: E402
-from neural3d.model import render_rays  # noqa: E402
-from neural3d.train import train  # noqa: E402
+from neural3d.train import make_optimizer, train, train_step  # noqa: E402
 from neural3d.trained import TrainedField, build_field  # noqa: E402
 
 WWR_TARGET_PCT = 5.0
@@ -60,20 +58,14 @@ def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.de
     px = frames_to_pixels(frames, norm, device)
     torch.manual_seed(0)
     field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
-    opt = torch.optim.Adam(field.parameters(), lr=config.lr, eps=1e-15)
+    optimizer, scheduler = make_optimizer(field, config)
     lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     gen = torch.Generator(device=device).manual_seed(0)
 
     def step(i: int) -> None:
-        field.set_step(i)
-        idx = torch.randint(len(px), (config.rays_per_batch,), generator=gen, device=device)
-        out = render_rays(field, px.origins[idx], px.dirs[idx], lo, hi, config, step=i,
-                          training=True, background_class=bg, generator=gen)
-        loss, _ = total_loss(out, px.rgb[idx], px.labels[idx], config, background_class=bg)
-        opt.zero_grad()
-        loss.backward()
-        opt.step()
+        train_step(field, optimizer, scheduler, px, lo, hi, config, step=i,
+                   background_class=bg, generator=gen)
         if device.type == "cuda":
             torch.cuda.synchronize(device)
 

@@ -17,7 +17,7 @@ import math
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 
@@ -31,6 +31,7 @@ from dataset.scene import read_scene
 from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
 from neural3d.config import PRESETS, TrainConfig, config_from_dict, config_to_dict, preset_config
 from neural3d.data import (
+    Pixels,
     background_class,
     frames_to_pixels,
     load_frames,
@@ -38,8 +39,9 @@ from neural3d.data import (
     scene_normalisation,
 )
 from neural3d.evaluate import evaluate
+from neural3d.fields import SemanticSDF
 from neural3d.losses import psnr, total_loss
-from neural3d.model import render_rays
+from neural3d.model import RenderOutput, render_rays
 from neural3d.normalisation import Normalisation
 from neural3d.trained import TrainedField, build_field
 
@@ -57,6 +59,50 @@ def lr_factor(step: int, config: TrainConfig) -> float:
     progress = min((step - config.warmup) / max(config.iterations - config.warmup, 1), 1.0)
     return config.lr_final_factor + (1 - config.lr_final_factor) * 0.5 * (
         1 + math.cos(math.pi * progress))
+
+
+def make_optimizer(field: torch.nn.Module, config: TrainConfig
+                   ) -> tuple[torch.optim.Adam, torch.optim.lr_scheduler.LambdaLR]:
+    """Adam over all of ``field``'s parameters and its warm-up + cosine schedule."""
+    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
+    return optimizer, torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor,
+                                                                           config=config))
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """One training step: the loss (detached), its weighted parts, the batch and its render."""
+
+    loss: float
+    parts: dict[str, float]
+    pixel_index: torch.Tensor  # "(R,)" rows of the pixels the batch used
+    render: RenderOutput
+
+
+def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
+               scheduler: torch.optim.lr_scheduler.LRScheduler | None, pixels: Pixels,
+               box_min: torch.Tensor, box_max: torch.Tensor, config: TrainConfig, *,
+               step: int, background_class: int, generator: torch.Generator) -> StepResult:
+    """One optimisation step at ``step`` (the only training step; the bench calls it too).
+
+    Draws ``config.rays_per_batch`` pixels with ``generator``, renders them, takes
+    the weighted loss and one optimizer (and scheduler, if given) step.
+    """
+    field.set_step(step)
+    idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
+                        device=pixels.rgb.device)
+    out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max, config,
+                      step=step, training=True, background_class=background_class,
+                      generator=generator)
+    depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
+    loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
+                             background_class=background_class, depth_t=depth_t)
+    optimizer.zero_grad(set_to_none=True)
+    loss.backward()
+    optimizer.step()
+    if scheduler is not None:
+        scheduler.step()
+    return StepResult(float(loss.detach()), parts, idx, out)
 
 
 def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.device,
@@ -99,8 +145,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
         field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
-    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
-    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor, config=config))
+    optimizer, scheduler = make_optimizer(field, config)
     gen = torch.Generator(device=device).manual_seed(config.seed)
     step, train_s, log_rows, evals = 0, 0.0, [], []
     if resume:
@@ -129,25 +174,15 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     try:
         while step < config.iterations:
             tic = time.perf_counter()
-            field.set_step(step)
-            idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=gen,
-                                device=device)
-            out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max,
-                              config, step=step, training=True, background_class=bg,
-                              generator=gen)
-            depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
-            loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
-                                     background_class=bg, depth_t=depth_t)
-            optimizer.zero_grad(set_to_none=True)
-            loss.backward()
-            optimizer.step()
-            scheduler.step()
+            result = train_step(field, optimizer, scheduler, pixels, box_min, box_max, config,
+                                step=step, background_class=bg, generator=gen)
             step += 1
             train_s += time.perf_counter() - tic
             bar.update(1)
             if step % LOG_EVERY == 0 or step == config.iterations:
-                row = {"step": step, "train_s": round(train_s, 3), "loss": float(loss.detach()),
-                       **parts, "psnr": psnr(out.rgb.detach(), pixels.rgb[idx]),
+                row = {"step": step, "train_s": round(train_s, 3), "loss": result.loss,
+                       **result.parts,
+                       "psnr": psnr(result.render.rgb.detach(), pixels.rgb[result.pixel_index]),
                        "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0]}
                 log_rows.append(row)
                 _write_log(run_dir, log_rows)

@@ -165,3 +165,13 @@ def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
     run = train(scene, config, tmp_path, device=CPU)
     field = load_trained_field(run, device=CPU)
     assert torch.isfinite(field.sdf_m(torch.zeros(4, 3))).all()
+
+
+def test_train_step_is_the_only_training_step():
+    """bench/neural3d.py calls neural3d.train.train_step; it has no loss/backward of its own."""
+    from pathlib import Path
+
+    bench = (Path(__file__).resolve().parent.parent / "bench" / "neural3d.py").read_text()
+    assert "train_step(" in bench
+    for copy in ("total_loss", ".backward(", "render_rays", "torch.optim.Adam"):
+        assert copy not in bench, f"bench/neural3d.py has its own {copy}"
