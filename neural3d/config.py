@@ -74,6 +74,7 @@ class TrainConfig:
     scene_box_margin: float = 0.1  # fraction of the visual-hull box added on each side
     eval_every: int = 500
     eval_max_frames: int = 4
+    eval_rays_per_frame: int = 1024  # random pixels of each eval frame, drawn once (0 = all)
     checkpoint_every: int = 500
     seed: int = 0
 
@@ -83,6 +84,9 @@ class TrainConfig:
         for name in positive:
             if getattr(self, name) <= 0:
                 raise ValueError(f"TrainConfig.{name} must be positive, got {getattr(self, name)}")
+        if self.eval_rays_per_frame < 0:
+            raise ValueError(f"TrainConfig.eval_rays_per_frame must be >= 0 (0 = every pixel), "
+                             f"got {self.eval_rays_per_frame}")
         if self.lr <= 0 or not 0 < self.image_scale <= 1:
             raise ValueError(
                 f"TrainConfig needs lr > 0 and 0 < image_scale <= 1, got lr={self.lr}, "

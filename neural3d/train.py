@@ -2,7 +2,7 @@
 
 Run folder ``<out>/<scene name>/``: config.json, run.json (scene, normalisation,
 device, code version), checkpoint.pt (atomic; every ``checkpoint_every`` steps,
-at the end and on Ctrl-C), log.csv, eval.json. ``--resume`` continues from the
+at the end and on Ctrl-C or SIGTERM), log.csv, eval.json. ``--resume`` continues from the
 checkpoint and matches an uninterrupted run (optimizer, scheduler and random
 generator states are restored).
 """
@@ -14,7 +14,9 @@ import csv
 import io
 import json
 import math
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -38,7 +40,7 @@ from neural3d.data import (
     scene_name,
     scene_normalisation,
 )
-from neural3d.evaluate import evaluate
+from neural3d.evaluate import eval_pixel_subset, evaluate
 from neural3d.fields import SemanticSDF
 from neural3d.losses import psnr, total_loss
 from neural3d.model import RenderOutput, render_rays
@@ -140,14 +142,16 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     if eval_frames:
         chosen = load_frames(scene, "eval", image_scale=config.image_scale)
         pick = torch.linspace(0, len(chosen) - 1, min(config.eval_max_frames, len(chosen)))
-        eval_pixels = frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device)
+        eval_pixels = eval_pixel_subset(
+            frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device),
+            config.eval_rays_per_frame, seed=config.seed)
 
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
         field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
     optimizer, scheduler = make_optimizer(field, config)
     gen = torch.Generator(device=device).manual_seed(config.seed)
-    step, train_s, log_rows, evals = 0, 0.0, [], []
+    step, train_s, eval_s, log_rows, evals = 0, 0.0, 0.0, [], []
     if resume:
         state = read_checkpoint(run_dir / CHECKPOINT_NAME, device)
         field.load_state_dict(state["field"])
@@ -155,6 +159,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         scheduler.load_state_dict(state["scheduler"])
         gen.set_state(state["generator"].cpu())
         step, train_s = int(state["step"]), float(state["train_s"])
+        eval_s = float(state.get("eval_s", 0.0))
         log_rows = [r for r in _read_log(run_dir) if int(r["step"]) <= step]
         evals = [e for e in _read_evals(run_dir) if e["step"] <= step]
     box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
@@ -165,12 +170,13 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         write_checkpoint(run_dir / CHECKPOINT_NAME, {
             "step": step, "field": field.state_dict(), "optimizer": optimizer.state_dict(),
             "scheduler": scheduler.state_dict(), "generator": gen.get_state(),
-            "train_s": train_s,
+            "train_s": train_s, "eval_s": eval_s,
         })
         _write_log(run_dir, log_rows)
 
     bar = tqdm(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
                dynamic_ncols=True, disable=None)
+    previous_sigterm = _sigterm_as_interrupt()
     try:
         while step < config.iterations:
             tic = time.perf_counter()
@@ -192,9 +198,13 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
                 save()
             if step % config.eval_every == 0 or step == config.iterations or stop:
                 if eval_pixels is not None:
+                    tic = time.perf_counter()
                     figures = evaluate(field, eval_pixels, box_min, box_max, config, step=step,
                                        background_class=bg)
-                    evals.append({"step": step, "train_s": round(train_s, 3), **figures})
+                    eval_s += time.perf_counter() - tic
+                    evals.append({"step": step, "train_s": round(train_s, 3),
+                                  "eval_s": round(eval_s, 3), "eval_rays": len(eval_pixels),
+                                  **figures})
                     write_json_atomic(run_dir / "eval.json", {"evaluations": evals})
                 if callback is not None:
                     field.eval()
@@ -209,8 +219,25 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         raise
     finally:
         bar.close()
+        if previous_sigterm is not None:
+            signal.signal(signal.SIGTERM, previous_sigterm)
     save()
     return run_dir
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def _sigterm_as_interrupt():
+    """Make SIGTERM raise KeyboardInterrupt (so it saves a checkpoint as Ctrl-C does).
+
+    Returns the previous handler to restore, or None off the main thread (where
+    Python cannot install handlers; such a caller handles its own signals).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _raise_interrupt)
 
 
 def _start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
@@ -281,6 +308,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-minutes", type=float, default=None,
                         help="stop after this many minutes of training (a checkpoint is kept)")
     parser.add_argument("--iterations", type=int, default=None, help="override the preset")
+    parser.add_argument("--eval-every", type=int, default=None,
+                        help="steps between held-out evaluations (override the preset)")
+    parser.add_argument("--eval-rays", type=int, default=None,
+                        help="random pixels scored per eval frame (0 = every pixel; preset "
+                             "default 1024); evaluation time is reported as eval_s")
     parser.add_argument("--depth-loss", action="store_true",
                         help="variant: also supervise rendered depth with the depth images")
     args = parser.parse_args(argv)
@@ -294,6 +326,10 @@ def main(argv: list[str] | None = None) -> int:
                 config = replace(config, iterations=args.iterations)
             if args.depth_loss:
                 config = replace(config, depth_loss=True)
+            if args.eval_every is not None:
+                config = replace(config, eval_every=args.eval_every)
+            if args.eval_rays is not None:
+                config = replace(config, eval_rays_per_frame=args.eval_rays)
         max_s = None if args.max_minutes is None else 60.0 * args.max_minutes
         out = train(args.scene, config, args.out, device=args.device, resume=args.resume,
                     max_seconds=max_s)

@@ -175,3 +175,29 @@ def test_train_step_is_the_only_training_step():
     assert "train_step(" in bench
     for copy in ("total_loss", ".backward(", "render_rays", "torch.optim.Adam"):
         assert copy not in bench, f"bench/neural3d.py has its own {copy}"
+
+
+def test_sigterm_saves_a_checkpoint_like_ctrl_c(scene, tmp_path):
+    """The CLI run is killed with SIGTERM mid-training; its checkpoint is there to resume."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    env = {**os.environ, "PYTHONPATH": str(root), "OMP_NUM_THREADS": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "neural3d.train", "--scene", str(scene), "--preset", "tiny",
+         "--iterations", "100000", "--out", str(tmp_path)],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log = tmp_path / "box" / "log.csv"
+    deadline = time.monotonic() + 120
+    while not (log.is_file() and len(log.read_text().splitlines()) > 2):  # >= 20 steps done
+        assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read()
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "checkpoint saved" in err
+    assert read_checkpoint(tmp_path / "box" / "checkpoint.pt", CPU)["step"] >= 20
