@@ -45,6 +45,7 @@ from neural3d.fields import SemanticSDF
 from neural3d.losses import psnr, total_loss
 from neural3d.model import RenderOutput, render_rays
 from neural3d.normalisation import Normalisation
+from neural3d.occupancy import OccupancyGrid
 from neural3d.trained import TrainedField, build_field
 
 LOG_EVERY = 10  # steps between log.csv rows
@@ -81,21 +82,35 @@ class StepResult:
     render: RenderOutput
 
 
+def make_occupancy(config: TrainConfig, box_min: torch.Tensor, box_max: torch.Tensor
+                   ) -> OccupancyGrid | None:
+    """The run's occupancy grid over the box "(3,)", or None when ``occupancy_resolution`` is 0."""
+    if config.occupancy_resolution == 0:
+        return None
+    return OccupancyGrid(box_min, box_max, config.occupancy_resolution)
+
+
 def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
                scheduler: torch.optim.lr_scheduler.LRScheduler | None, pixels: Pixels,
                box_min: torch.Tensor, box_max: torch.Tensor, config: TrainConfig, *,
-               step: int, background_class: int, generator: torch.Generator) -> StepResult:
+               step: int, background_class: int, generator: torch.Generator,
+               occupancy: OccupancyGrid | None = None) -> StepResult:
     """One optimisation step at ``step`` (the only training step; the bench calls it too).
 
     Draws ``config.rays_per_batch`` pixels with ``generator``, renders them, takes
-    the weighted loss and one optimizer (and scheduler, if given) step.
+    the weighted loss and one optimizer (and scheduler, if given) step. With an
+    ``occupancy`` grid, rays skip empty space; the grid is refreshed from the SDF
+    at ``occupancy_start`` and every ``occupancy_every`` steps after.
     """
     field.set_step(step)
+    if occupancy is not None and step >= config.occupancy_start and (
+            step - config.occupancy_start) % config.occupancy_every == 0:
+        occupancy.update_from_sdf(field.sdf, margin=config.occupancy_margin_cells * occupancy.cell)
     idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
                         device=pixels.rgb.device)
     out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max, config,
                       step=step, training=True, background_class=background_class,
-                      generator=generator)
+                      generator=generator, occupancy=occupancy)
     depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
     loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
                              background_class=background_class, depth_t=depth_t)
@@ -165,12 +180,16 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     classes = tuple(scene.semantic_classes)
+    occupancy = make_occupancy(config, box_min, box_max)
+    if resume and occupancy is not None and "occupancy" in state:
+        occupancy.occupied = state["occupancy"].to(device)
 
     def save() -> None:
         write_checkpoint(run_dir / CHECKPOINT_NAME, {
             "step": step, "field": field.state_dict(), "optimizer": optimizer.state_dict(),
             "scheduler": scheduler.state_dict(), "generator": gen.get_state(),
             "train_s": train_s, "eval_s": eval_s,
+            **({} if occupancy is None else {"occupancy": occupancy.occupied}),
         })
         _write_log(run_dir, log_rows)
 
@@ -181,7 +200,8 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         while step < config.iterations:
             tic = time.perf_counter()
             result = train_step(field, optimizer, scheduler, pixels, box_min, box_max, config,
-                                step=step, background_class=bg, generator=gen)
+                                step=step, background_class=bg, generator=gen,
+                                occupancy=occupancy)
             step += 1
             train_s += time.perf_counter() - tic
             bar.update(1)

@@ -201,3 +201,13 @@ def test_sigterm_saves_a_checkpoint_like_ctrl_c(scene, tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130 and "checkpoint saved" in err
     assert read_checkpoint(tmp_path / "box" / "checkpoint.pt", CPU)["step"] >= 20
+
+
+def test_training_with_occupancy_grid_refreshes_and_checkpoints_it(scene, tmp_path):
+    config = replace(preset_config("tiny"), iterations=6, rays_per_batch=32, eval_every=6,
+                     checkpoint_every=6, occupancy_resolution=16, occupancy_start=2,
+                     occupancy_every=2)
+    run = train(scene, config, tmp_path, device=CPU)
+    state = read_checkpoint(run / "checkpoint.pt", CPU)
+    occupied = state["occupancy"]
+    assert occupied.dtype == torch.bool and 0 < occupied.float().mean() < 1  # refreshed
