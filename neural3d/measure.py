@@ -265,7 +265,7 @@ def measure_semantic_mesh(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross_facade_area_m2(wall, window, door),
-        wwr=_wwr_or_none(window, wall, door),
+        wwr=wwr_or_none(window, wall, door),
         facades=facades,
         ungrouped_facade_area_m2=ungrouped,
     )
@@ -296,7 +296,7 @@ def _facade_figures(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross,
-        wwr=_wwr_or_none(window, wall, door),
+        wwr=wwr_or_none(window, wall, door),
         width_m=gross / height if height > 0 else 0.0,
         height_m=height,
         face_count=int(mask.sum()),
@@ -322,7 +322,8 @@ def _azimuth_peaks_deg(azimuth_deg: np.ndarray, weight: np.ndarray,
     return np.array(peaks)
 
 
-def _wwr_or_none(window: float, wall: float, door: float) -> float | None:
+def wwr_or_none(window: float, wall: float, door: float) -> float | None:
+    """WWR of the areas (m²), or None without facade area."""
     gross = gross_facade_area_m2(wall, window, door)
     return window_to_wall_ratio(window, gross) if gross > 0 else None
 
