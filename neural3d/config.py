@@ -75,6 +75,9 @@ class TrainConfig:
     occupancy_start: int = 200  # first refresh from the SDF (the box until then)
     occupancy_every: int = 50  # steps between refreshes
     occupancy_margin_cells: float = 1.0  # |sdf| margin beyond the half diagonal, in cells
+    # weight averaging: the measured field is an exponential moving average of the trained
+    # one (decay per step; 0 = off); evaluations, callbacks and load_trained_field use it
+    ema_decay: float = 0.0
     image_scale: float = 1.0  # images are resized by this factor on load
     scene_box_margin: float = 0.1  # fraction of the visual-hull box added on each side
     eval_every: int = 500
@@ -94,6 +97,8 @@ class TrainConfig:
             raise ValueError(f"TrainConfig needs occupancy_resolution 0 (off) or >= 2 and "
                              f"occupancy_every > 0, got {self.occupancy_resolution}, "
                              f"{self.occupancy_every}")
+        if not 0.0 <= self.ema_decay < 1.0:
+            raise ValueError(f"TrainConfig.ema_decay must be in [0, 1), got {self.ema_decay}")
         if self.eval_rays_per_frame < 0:
             raise ValueError(f"TrainConfig.eval_rays_per_frame must be >= 0 (0 = every pixel), "
                              f"got {self.eval_rays_per_frame}")

@@ -10,6 +10,7 @@ generator states are restored).
 from __future__ import annotations
 
 import argparse
+import copy
 import csv
 import io
 import json
@@ -80,6 +81,15 @@ class StepResult:
     parts: dict[str, float]
     pixel_index: torch.Tensor  # "(R,)" rows of the pixels the batch used
     render: RenderOutput
+
+
+@torch.no_grad()
+def update_ema(average: torch.nn.Module, field: torch.nn.Module, decay: float) -> None:
+    """``average`` <- decay * average + (1 - decay) * field (parameters); buffers copied."""
+    for a, p in zip(average.parameters(), field.parameters()):
+        a.lerp_(p, 1.0 - decay)
+    for a, b in zip(average.buffers(), field.buffers()):
+        a.copy_(b)
 
 
 def make_occupancy(config: TrainConfig, box_min: torch.Tensor, box_max: torch.Tensor
@@ -165,11 +175,16 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         torch.manual_seed(config.seed)
         field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
     optimizer, scheduler = make_optimizer(field, config)
+    average = None
+    if config.ema_decay > 0:
+        average = copy.deepcopy(field).requires_grad_(False)
     gen = torch.Generator(device=device).manual_seed(config.seed)
     step, train_s, eval_s, log_rows, evals = 0, 0.0, 0.0, [], []
     if resume:
         state = read_checkpoint(run_dir / CHECKPOINT_NAME, device)
         field.load_state_dict(state["field"])
+        if average is not None:
+            average.load_state_dict(state.get("ema", state["field"]))
         optimizer.load_state_dict(state["optimizer"])
         scheduler.load_state_dict(state["scheduler"])
         gen.set_state(state["generator"].cpu())
@@ -181,6 +196,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     classes = tuple(scene.semantic_classes)
     occupancy = make_occupancy(config, box_min, box_max)
+    measured = field if average is None else average
     if resume and occupancy is not None and "occupancy" in state:
         occupancy.occupied = state["occupancy"].to(device)
 
@@ -190,6 +206,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             "scheduler": scheduler.state_dict(), "generator": gen.get_state(),
             "train_s": train_s, "eval_s": eval_s,
             **({} if occupancy is None else {"occupancy": occupancy.occupied}),
+            **({} if average is None else {"ema": average.state_dict()}),
         })
         _write_log(run_dir, log_rows)
 
@@ -202,6 +219,8 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             result = train_step(field, optimizer, scheduler, pixels, box_min, box_max, config,
                                 step=step, background_class=bg, generator=gen,
                                 occupancy=occupancy)
+            if average is not None:
+                update_ema(average, field, config.ema_decay)
             step += 1
             train_s += time.perf_counter() - tic
             bar.update(1)
@@ -219,7 +238,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             if step % config.eval_every == 0 or step == config.iterations or stop:
                 if eval_pixels is not None:
                     tic = time.perf_counter()
-                    figures = evaluate(field, eval_pixels, box_min, box_max, config, step=step,
+                    figures = evaluate(measured, eval_pixels, box_min, box_max, config, step=step,
                                        background_class=bg)
                     eval_s += time.perf_counter() - tic
                     evals.append({"step": step, "train_s": round(train_s, 3),
@@ -227,10 +246,10 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
                                   **figures})
                     write_json_atomic(run_dir / "eval.json", {"evaluations": evals})
                 if callback is not None:
-                    field.eval()
-                    answer = callback(step, TrainedField(field, norm, scene_dir=scene_dir,
+                    measured.eval()
+                    answer = callback(step, TrainedField(measured, norm, scene_dir=scene_dir,
                                                          class_names=classes))
-                    field.train()
+                    measured.train()
                     stop = stop or answer is True
             if stop:
                 break

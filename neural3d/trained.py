@@ -101,7 +101,7 @@ def load_trained_field(run_dir: Path, *, device: torch.device) -> TrainedField:
     norm = Normalisation.from_json_dict(run["normalisation"])
     field = build_field(config.model, len(run["class_names"]), norm).to(device)
     state = read_checkpoint(run_dir / "checkpoint.pt", device)
-    field.load_state_dict(state["field"])
+    field.load_state_dict(state.get("ema", state["field"]))  # the averaged weights if any
     field.set_step(int(state["step"]))
     field.eval()
     return TrainedField(field, norm, scene_dir=Path(run["scene_dir"]),

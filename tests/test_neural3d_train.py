@@ -211,3 +211,32 @@ def test_training_with_occupancy_grid_refreshes_and_checkpoints_it(scene, tmp_pa
     state = read_checkpoint(run / "checkpoint.pt", CPU)
     occupied = state["occupancy"]
     assert occupied.dtype == torch.bool and 0 < occupied.float().mean() < 1  # refreshed
+
+
+def test_update_ema_is_the_exponential_average():
+    from neural3d.train import update_ema
+
+    average, field = torch.nn.Linear(2, 1), torch.nn.Linear(2, 1)
+    with torch.no_grad():
+        for p in average.parameters():
+            p.fill_(0.0)
+        for p in field.parameters():
+            p.fill_(1.0)
+    for _ in range(3):
+        update_ema(average, field, 0.5)
+    assert torch.allclose(average.weight, torch.full((1, 2), 0.875))  # 1 - 0.5^3
+
+
+def test_training_with_ema_checkpoints_and_loads_the_averaged_field(scene, tmp_path):
+    config = replace(preset_config("tiny"), iterations=4, rays_per_batch=16, eval_every=4,
+                     checkpoint_every=4, ema_decay=0.5)
+    seen = []
+    run = train(scene, config, tmp_path, device=CPU,
+                callback=lambda s, f: seen.append(f.field.state_dict()["log_inv_s"].item()))
+    state = read_checkpoint(run / "checkpoint.pt", CPU)
+    assert state["ema"].keys() == state["field"].keys()
+    table = "sdf_net.encoding.grid.table"
+    assert not torch.equal(state["ema"][table], state["field"][table])
+    loaded = load_trained_field(run, device=CPU).field.state_dict()
+    assert torch.equal(loaded[table], state["ema"][table])
+    assert seen == [state["ema"]["log_inv_s"].item()]  # the callback measured the average
