@@ -7,7 +7,9 @@ plane's inward normal, from ``depth_m`` in front of the plane to ``depth_m``
 behind it; the first outside-to-inside crossing is the facade there (the wall,
 or the pane at the back of a window recess), and the semantic field's class at
 that point labels the cell. A cell whose probe finds no crossing (beyond the
-wall's end, or in front of another wing) is no facade. So an opening counts
+wall's end, or in front of another wing), or whose crossing faces more than
+45 degrees away from the plane (the chamfered corner of the next wall), is no
+facade. So an opening counts
 with its projected area, as the truth does, and reveals, sills and labels
 bleeding around an opening's edge in the mesh do not add area.
 """
@@ -110,7 +112,15 @@ def plane_sampled_areas(sdf_fn: SdfFn, label_fn: LabelFn, extent: PlaneExtent, *
     a, b = sdf[rows, i[rows]], sdf[rows, i[rows] + 1]
     frac = a / np.where(a - b > 0, a - b, 1.0)
     depth = s[i[rows]] + frac * (s[i[rows] + 1] - s[i[rows]])
-    labels = label_fn(on_plane[rows] + depth[:, None] * n)
+    hit = on_plane[rows] + depth[:, None] * n
+    # A cell counts only where the surface faces the plane (within 45 degrees): the
+    # chamfered corner between two walls is then split between them, not counted twice.
+    step = 0.25 * cell_m
+    offsets = np.concatenate([np.zeros((1, 3)), step * np.eye(3)])
+    d = sdf_fn((hit[:, None, :] + offsets).reshape(-1, 3)).reshape(len(hit), 4)
+    grad = d[:, 1:] - d[:, :1]
+    facing = grad @ n > np.cos(np.radians(45.0)) * np.linalg.norm(grad, axis=1)
+    labels = np.where(facing, label_fn(hit), -1)
     cell_area = cell_m * cell_m
     return PlaneAreas(
         window_m2=float((labels == SemanticClass.WINDOW).sum() * cell_area),
