@@ -13,7 +13,8 @@ the one that does not depend on the neighbours.
 tiny preset, one building per family) and every ``--check-every`` iterations
 meshes and measures the field with part 2's ``neural3d.extract.measure_field``;
 reports the training time until WWR error <= 5 % and footprint IoU >= 0.96
-(the targets), and the final figures. Measuring time is not training time.
+(the targets), the final figures and their spread (max - min) over the last
+three checks. Measuring time is not training time.
 """
 
 from __future__ import annotations
@@ -41,9 +42,7 @@ from neural3d.data import (  # noqa: E402
     load_frames,
     scene_normalisation,
 )
-from neural3d.losses import total_loss  # noqa: E402
-from neural3d.model import render_rays  # noqa: E402
-from neural3d.train import train  # noqa: E402
+from neural3d.train import make_optimizer, train, train_step  # noqa: E402
 from neural3d.trained import TrainedField, build_field  # noqa: E402
 
 WWR_TARGET_PCT = 5.0
@@ -60,20 +59,14 @@ def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.de
     px = frames_to_pixels(frames, norm, device)
     torch.manual_seed(0)
     field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
-    opt = torch.optim.Adam(field.parameters(), lr=config.lr, eps=1e-15)
+    optimizer, scheduler = make_optimizer(field, config)
     lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     gen = torch.Generator(device=device).manual_seed(0)
 
     def step(i: int) -> None:
-        field.set_step(i)
-        idx = torch.randint(len(px), (config.rays_per_batch,), generator=gen, device=device)
-        out = render_rays(field, px.origins[idx], px.dirs[idx], lo, hi, config, step=i,
-                          training=True, background_class=bg, generator=gen)
-        loss, _ = total_loss(out, px.rgb[idx], px.labels[idx], config, background_class=bg)
-        opt.zero_grad()
-        loss.backward()
-        opt.step()
+        train_step(field, optimizer, scheduler, px, lo, hi, config, step=i,
+                   background_class=bg, generator=gen)
         if device.type == "cuda":
             torch.cuda.synchronize(device)
 
@@ -118,8 +111,10 @@ def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.
         tic = time.perf_counter()
         result, _ = measure_field(field, extract, device=device)
         errors = building_errors(result, truth)
-        row = {"step": step, "wall_s": tic - start - measuring,
-               "wwr_ape": errors.wwr_ape, "footprint_iou": errors.footprint_iou}
+        wall_s = tic - start - measuring
+        row = {"step": step, "wall_s": wall_s, "it_per_s": step / wall_s,
+               "wwr_ape": errors.wwr_ape, "window_ape": errors.window_ape,
+               "facade_ape": errors.facade_ape, "footprint_iou": errors.footprint_iou}
         measuring += time.perf_counter() - tic
         checks.append(row)
         print(f"  {scene_dir.name} step {step}: {row}", flush=True)
@@ -128,7 +123,18 @@ def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.
     train(scene_dir, config, out_dir, device=device, max_seconds=60.0 * minutes, callback=check)
     return {"scene": scene_dir.name, "family": truth.type if truth else None, "checks": checks,
             "target_reached": next((c for c in checks if _on_target(c)), None),
-            "final": checks[-1] if checks else None}
+            "final": checks[-1] if checks else None, "last3_spread": last_checks_spread(checks)}
+
+
+def last_checks_spread(checks: list[dict], n: int = 3) -> dict[str, float | None]:
+    """Max - min of WWR error (points of %) and footprint IoU over the last ``n`` checks."""
+    tail = checks[-n:]
+
+    def spread(key: str) -> float | None:
+        values = [c[key] for c in tail if c.get(key) is not None]
+        return max(values) - min(values) if len(values) == n else None
+
+    return {"wwr_ape": spread("wwr_ape"), "footprint_iou": spread("footprint_iou")}
 
 
 def _on_target(row: dict) -> bool:
@@ -155,8 +161,10 @@ def converge(args: argparse.Namespace) -> dict:
         results.append(r)
         reached, final = r["target_reached"], r["final"] or {}
         minutes = f"{reached['wall_s'] / 60:.1f}" if reached else "not reached"
+        sp = r["last3_spread"]
         print(f"| {r['scene']} | {minutes} | {final.get('step')} | {final.get('wwr_ape')} | "
-              f"{final.get('footprint_iou')} |", flush=True)
+              f"{final.get('footprint_iou')} | {sp['wwr_ape']} | {sp['footprint_iou']} |",
+              flush=True)
     return {"converge": results, "device": str(device), "config": "fast",
             "overrides": list(args.set)}
 
@@ -210,8 +218,8 @@ def main(argv: list[str] | None = None) -> int:
                   "|---|---|---|---|---|---|")
             figures = speed(args)
         else:
-            print("| scene | minutes to target | final step | WWR APE % | footprint IoU |\n"
-                  "|---|---|---|---|---|")
+            print("| scene | minutes to target | final step | WWR APE % | footprint IoU | "
+                  "WWR spread, last 3 checks | IoU spread |\n|---|---|---|---|---|---|---|")
             figures = converge(args)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)

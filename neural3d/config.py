@@ -70,10 +70,19 @@ class TrainConfig:
     mask_weight: float = 0.1  # silhouette term from the background class (0 = off)
     depth_loss: bool = False  # variant: supervise rendered depth with the depth images
     depth_weight: float = 0.1
+    # empty-space skipping (neural3d.occupancy); occupancy_resolution 0 = off
+    occupancy_resolution: int = 0  # cells along the box's longest side
+    occupancy_start: int = 200  # first refresh from the SDF (the box until then)
+    occupancy_every: int = 50  # steps between refreshes
+    occupancy_margin_cells: float = 1.0  # |sdf| margin beyond the half diagonal, in cells
+    # weight averaging: the measured field is an exponential moving average of the trained
+    # one (decay per step; 0 = off); evaluations, callbacks and load_trained_field use it
+    ema_decay: float = 0.0
     image_scale: float = 1.0  # images are resized by this factor on load
     scene_box_margin: float = 0.1  # fraction of the visual-hull box added on each side
     eval_every: int = 500
     eval_max_frames: int = 4
+    eval_rays_per_frame: int = 1024  # random pixels of each eval frame, drawn once (0 = all)
     checkpoint_every: int = 500
     seed: int = 0
 
@@ -83,6 +92,16 @@ class TrainConfig:
         for name in positive:
             if getattr(self, name) <= 0:
                 raise ValueError(f"TrainConfig.{name} must be positive, got {getattr(self, name)}")
+        if self.occupancy_resolution and (self.occupancy_resolution < 2
+                                          or self.occupancy_every <= 0):
+            raise ValueError(f"TrainConfig needs occupancy_resolution 0 (off) or >= 2 and "
+                             f"occupancy_every > 0, got {self.occupancy_resolution}, "
+                             f"{self.occupancy_every}")
+        if not 0.0 <= self.ema_decay < 1.0:
+            raise ValueError(f"TrainConfig.ema_decay must be in [0, 1), got {self.ema_decay}")
+        if self.eval_rays_per_frame < 0:
+            raise ValueError(f"TrainConfig.eval_rays_per_frame must be >= 0 (0 = every pixel), "
+                             f"got {self.eval_rays_per_frame}")
         if self.lr <= 0 or not 0 < self.image_scale <= 1:
             raise ValueError(
                 f"TrainConfig needs lr > 0 and 0 < image_scale <= 1, got lr={self.lr}, "

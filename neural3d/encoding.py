@@ -130,3 +130,42 @@ class GridEncoding(nn.Module):
         values = _FlatGather.apply(self.table, index.reshape(n, self.levels, 8))  # (N, L, 8, F)
         feats = (weights.reshape(n, self.levels, 8, 1) * values).sum(2)
         return (feats * self.level_mask[:, None]).reshape(n, self.out_dim)
+
+
+class PositionalInput(nn.Module):
+    """The ``mlp`` backbone's input: "(N, 3)" -> "(N, out_dim)" = [x, sin, cos] (NeRF)."""
+
+    def __init__(self, frequencies: int) -> None:
+        super().__init__()
+        self.frequencies = frequencies
+        self.out_dim = 3 * (1 + 2 * frequencies)
+
+    def set_step(self, step: int) -> None:
+        """No schedule: the encoding is fixed."""
+
+    def forward(self, x: Tensor) -> Tensor:
+        return positional_encoding(x, self.frequencies)
+
+
+class GridInput(nn.Module):
+    """The ``grid`` backbone's input: "(N, 3)" -> "(N, out_dim)" = [x, grid features].
+
+    ``set_step`` runs the coarse-to-fine schedule: ``start_levels`` levels on at
+    step 0, all of them after ``ramp_steps``.
+    """
+
+    def __init__(self, grid: GridEncoding, *, start_levels: int, ramp_steps: int) -> None:
+        super().__init__()
+        self.grid = grid
+        self.start_levels, self.ramp_steps = start_levels, ramp_steps
+        self.out_dim = 3 + grid.out_dim
+
+    def set_step(self, step: int) -> None:
+        """Switch on the levels the coarse-to-fine schedule allows at ``step``."""
+        ramp = min(step / max(self.ramp_steps, 1), 1.0)
+        levels = self.grid.levels
+        self.grid.set_active_levels(self.start_levels + ramp * (levels - self.start_levels))
+
+    def forward(self, x: Tensor) -> Tensor:
+        return torch.cat([x, self.grid(x)], dim=-1)
+

@@ -1,4 +1,9 @@
-"""Held-out evaluation: render the eval frames, report PSNR and semantic accuracy."""
+"""Held-out evaluation: render eval pixels, report PSNR, semantic accuracy and silhouette IoU.
+
+Full frames are costly (a 512² frame is 262k rays); :func:`eval_pixel_subset`
+draws a fixed random subset of each frame's pixels once, so every evaluation of
+a run scores the same rays.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +16,28 @@ from neural3d.losses import psnr
 from neural3d.model import render_rays
 
 _EVAL_CHUNK = 2048  # rays per forward pass
+
+
+def eval_pixel_subset(pixels: Pixels, rays_per_frame: int, *, seed: int) -> Pixels:
+    """``rays_per_frame`` random pixels of each frame of ``pixels`` (all of them when 0).
+
+    The draw depends only on ``seed`` and the frame sizes. The subset's ``shapes``
+    are ``(1, n)`` per frame (its pixels no longer form images).
+    """
+    if rays_per_frame <= 0:
+        return pixels
+    gen = torch.Generator().manual_seed(seed)
+    picks, shapes, start = [], [], 0
+    for h, w in pixels.shapes:
+        n = min(rays_per_frame, h * w)
+        picks.append(start + torch.randperm(h * w, generator=gen)[:n])
+        shapes.append((1, n))
+        start += h * w
+    idx = torch.cat(picks).to(pixels.labels.device)
+    return Pixels(origins=pixels.origins[idx], dirs=pixels.dirs[idx], rgb=pixels.rgb[idx],
+                  labels=pixels.labels[idx],
+                  depth_t=None if pixels.depth_t is None else pixels.depth_t[idx],
+                  shapes=tuple(shapes))
 
 
 def render_pixels(field: SemanticSDF, pixels: Pixels, box_min: torch.Tensor,

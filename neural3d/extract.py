@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +33,7 @@ from dataset.device import resolve_device
 from dataset.footprint import polygon_to_geojson
 from dataset.resources import check_mesh_resources
 from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
+from dataset.wwr import wwr_from_areas
 from neural3d.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
 from neural3d.footprint import footprint_from_sdf
 from neural3d.measure import MeshMeasurement, measure_semantic_mesh
@@ -46,6 +47,7 @@ from neural3d.meshing import (
     label_vertices,
     write_semantic_ply,
 )
+from neural3d.plane_sampling import plane_extents, plane_sampled_areas
 
 METHOD = "neural3d"
 PROTOCOL = "train"
@@ -131,6 +133,8 @@ def measure_field(
     mesh = semantic_mesh_of_field(trained, config, device, progress=progress)
     m = measure_semantic_mesh(mesh.vertices_m, mesh.faces, mesh.vertex_labels,
                               config=config.measure)
+    if config.areas == "planes":
+        m = with_plane_sampled_areas(m, mesh, trained, config, device)
     warnings: list[str] = []
     if m.wwr is None:
         warnings.append("the mesh has no wall, window or door vertex: WWR undefined")
@@ -155,6 +159,26 @@ def measure_field(
         wall_time_s=time.perf_counter() - start, warnings=tuple(warnings),
     )
     return result, mesh
+
+
+def with_plane_sampled_areas(m: MeshMeasurement, mesh: SemanticMesh, trained,
+                             config: ExtractConfig, device: torch.device) -> MeshMeasurement:
+    """``m`` with its whole-building areas and WWR read on its facade planes' grids.
+
+    Per-facade figures stay the mesh's. See :mod:`neural3d.plane_sampling`.
+    """
+    extents = plane_extents(mesh.vertices_m, mesh.faces,
+                            tuple((f.azimuth_deg, f.offset_m) for f in m.facades),
+                            slab_m=config.measure.plane_slab_m,
+                            max_angle_deg=config.measure.plane_max_angle_deg)
+    sdf = field_sdf_fn(trained, device, config.chunk_points)
+    label = field_label_fn(trained, device, config.chunk_points)
+    areas = [plane_sampled_areas(sdf, label, e, cell_m=config.plane_cell_m,
+                                 depth_m=config.plane_depth_m) for e in extents]
+    window, wall, door = (sum(getattr(a, k) for a in areas)
+                          for k in ("window_m2", "wall_m2", "door_m2"))
+    return replace(m, window_area_m2=window, wall_area_m2=wall, door_area_m2=door,
+                   facade_area_m2=wall + window + door, wwr=wwr_from_areas(window, wall, door))
 
 
 def extract_run(

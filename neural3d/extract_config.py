@@ -8,6 +8,7 @@ field (``metrics.methods``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -39,8 +40,18 @@ class ExtractConfig:
     footprint_cell_m: float | None = None
     footprint_min_area_m2: float = 1.0
     measure: MeasureConfig = field(default_factory=MeasureConfig)
+    # whole-building window/wall/door areas: from the mesh's vertex labels, or read from the
+    # fields on each facade plane's grid (neural3d.plane_sampling)
+    areas: Literal["mesh", "planes"] = "mesh"
+    plane_cell_m: float = 0.1
+    plane_depth_m: float = 0.5  # probed in front of and behind each plane
 
     def __post_init__(self) -> None:
+        if self.areas not in ("mesh", "planes"):
+            raise ValueError(f"areas must be 'mesh' or 'planes', got {self.areas!r}")
+        if self.plane_cell_m <= 0 or self.plane_depth_m <= 0:
+            raise ValueError(f"plane_cell_m and plane_depth_m must be > 0, got "
+                             f"{self.plane_cell_m}, {self.plane_depth_m}")
         if self.resolution < 8:
             raise ValueError(f"resolution must be >= 8, got {self.resolution}")
         if self.chunk_points < 1:

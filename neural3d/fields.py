@@ -21,7 +21,7 @@ from torch import Tensor, nn
 from torch.nn.utils.parametrizations import weight_norm
 
 from neural3d.config import FieldConfig
-from neural3d.encoding import GridEncoding, positional_encoding
+from neural3d.encoding import GridEncoding, GridInput, PositionalInput, positional_encoding
 
 _SOFTPLUS_BETA = 100.0  # NeuS: close to ReLU but smooth, so the SDF has smooth normals
 _MAX_LOG_INV_S = math.log(1e4)  # keeps exp() finite; 1e4 is far sharper than any sample spacing
@@ -79,32 +79,39 @@ def _geometric_init(lin: nn.Linear, i: int, n: int, d_in: int, radius: float,
             lin.weight[:, -(d_in - 3):] = 0.0
 
 
+def sdf_backbone(config: FieldConfig, box_min: np.ndarray, box_max: np.ndarray
+                 ) -> tuple[PositionalInput | GridInput, GeometricMLP]:
+    """The SDF network's input encoding and decoder for ``config.backbone`` (chosen here only).
+
+    ``mlp``: positional encoding + the paper's deep MLP with a skip and weight
+    normalisation; ``grid``: multi-resolution grid over the box "(3,)" + a small
+    decoder. Both encodings map "(N, 3)" -> "(N, out_dim)" with x first and have
+    ``set_step(step)``.
+    """
+    out_dim = 1 + config.feature_dim
+    if config.backbone == "mlp":
+        encoding = PositionalInput(config.mlp_frequencies)
+        return encoding, GeometricMLP(
+            encoding.out_dim - 3, config.mlp_hidden, config.mlp_layers, out_dim,
+            radius=config.init_radius, skip=config.mlp_skip, normalise_weights=True)
+    if config.backbone == "grid":
+        grid = GridEncoding(box_min, box_max, levels=config.grid_levels,
+                            features=config.grid_features, min_res=config.grid_min_res,
+                            max_res=config.grid_max_res, log2_table=config.grid_log2_table)
+        encoding = GridInput(grid, start_levels=config.grid_start_levels,
+                             ramp_steps=config.grid_coarse_to_fine_steps)
+        return encoding, GeometricMLP(
+            encoding.out_dim - 3, config.grid_hidden, 2, out_dim, radius=config.init_radius,
+            skip=None, normalise_weights=False)
+    raise ValueError(f"unknown backbone {config.backbone!r}; use 'mlp' or 'grid'")
+
+
 class SDFNetwork(nn.Module):
     """Point "(N, 3)" -> (signed distance "(N,)", geometry feature "(N, F)"), normalised frame."""
 
     def __init__(self, config: FieldConfig, box_min: np.ndarray, box_max: np.ndarray) -> None:
         super().__init__()
-        self.backbone = config.backbone
-        self.frequencies = config.mlp_frequencies
-        self.grid: GridEncoding | None = None
-        if config.backbone == "mlp":
-            self.mlp = GeometricMLP(
-                6 * config.mlp_frequencies, config.mlp_hidden, config.mlp_layers,
-                1 + config.feature_dim, radius=config.init_radius, skip=config.mlp_skip,
-                normalise_weights=True,
-            )
-        elif config.backbone == "grid":
-            self.grid = GridEncoding(
-                box_min, box_max, levels=config.grid_levels, features=config.grid_features,
-                min_res=config.grid_min_res, max_res=config.grid_max_res,
-                log2_table=config.grid_log2_table,
-            )
-            self.mlp = GeometricMLP(
-                self.grid.out_dim, config.grid_hidden, 2, 1 + config.feature_dim,
-                radius=config.init_radius, skip=None, normalise_weights=False,
-            )
-        else:
-            raise ValueError(f"unknown backbone {config.backbone!r}; use 'mlp' or 'grid'")
+        self.encoding, self.mlp = sdf_backbone(config, box_min, box_max)
         self._calibrate_sphere(config.init_radius)
 
     @torch.no_grad()
@@ -132,10 +139,7 @@ class SDFNetwork(nn.Module):
         last.bias[0] = a * last.bias[0] + b
 
     def forward(self, x: Tensor) -> tuple[Tensor, Tensor]:
-        if self.grid is None:
-            h = self.mlp(positional_encoding(x, self.frequencies))
-        else:
-            h = self.mlp(torch.cat([x, self.grid(x)], dim=-1))
+        h = self.mlp(self.encoding(x))
         return h[:, 0], h[:, 1:]
 
 
@@ -179,13 +183,8 @@ class SemanticSDF(nn.Module):
         return self.log_inv_s.clamp(max=_MAX_LOG_INV_S).exp()
 
     def set_step(self, step: int) -> None:
-        """Coarse-to-fine schedule of the grid backbone (a no-op for ``mlp``)."""
-        grid = self.sdf_net.grid
-        if grid is None:
-            return
-        c = self.config
-        ramp = min(step / max(c.grid_coarse_to_fine_steps, 1), 1.0)
-        grid.set_active_levels(c.grid_start_levels + ramp * (c.grid_levels - c.grid_start_levels))
+        """The encoding's schedule at ``step`` (coarse to fine for ``grid``)."""
+        self.sdf_net.encoding.set_step(step)
 
     def sdf(self, x: Tensor) -> Tensor:
         """"(N, 3)" -> "(N,)" signed distance in normalised units."""

@@ -9,6 +9,7 @@ from torch import Tensor
 
 from neural3d.config import TrainConfig
 from neural3d.fields import SemanticSDF
+from neural3d.occupancy import OccupancyGrid
 from neural3d.rendering import (
     neus_alpha,
     render_accumulation,
@@ -45,14 +46,17 @@ def cos_anneal_ratio(config: TrainConfig, step: int) -> float:
 
 def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tensor,
                 box_max: Tensor, config: TrainConfig, *, step: int, training: bool,
-                background_class: int, generator: torch.Generator | None = None
-                ) -> RenderOutput:
+                background_class: int, generator: torch.Generator | None = None,
+                occupancy: OccupancyGrid | None = None) -> RenderOutput:
     """Render rays "(R, 3)" (unit ``dirs``) through the field inside the box "(3,)".
 
     ``training``: jitter the uniform samples and keep the graph for the eikonal term.
-    Rays that miss the box see only the environment.
+    Rays that miss the box see only the environment. ``occupancy``: clip each ray
+    to its occupied cells first (empty-space skipping).
     """
     near, far, hit = ray_box_near_far(origins, dirs, box_min, box_max)
+    if occupancy is not None:
+        near, far, hit = occupancy.clip_rays(origins, dirs, near, far, hit)
     idx = torch.nonzero(hit).squeeze(1)
     o, d = origins[idx], dirs[idx]
     t = uniform_samples(near[idx], far[idx], config.samples_uniform, perturb=training,

@@ -2,7 +2,7 @@
 
 Run folder ``<out>/<scene name>/``: config.json, run.json (scene, normalisation,
 device, code version), checkpoint.pt (atomic; every ``checkpoint_every`` steps,
-at the end and on Ctrl-C), log.csv, eval.json. ``--resume`` continues from the
+at the end and on Ctrl-C or SIGTERM), log.csv, eval.json. ``--resume`` continues from the
 checkpoint and matches an uninterrupted run (optimizer, scheduler and random
 generator states are restored).
 """
@@ -10,14 +10,17 @@ generator states are restored).
 from __future__ import annotations
 
 import argparse
+import copy
 import csv
 import io
 import json
 import math
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 
@@ -33,16 +36,19 @@ from dataset.scene import read_scene
 from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
 from neural3d.config import PRESETS, TrainConfig, config_from_dict, config_to_dict, preset_config
 from neural3d.data import (
+    Pixels,
     background_class,
     frames_to_pixels,
     load_frames,
     scene_name,
     scene_normalisation,
 )
-from neural3d.evaluate import evaluate
+from neural3d.evaluate import eval_pixel_subset, evaluate
+from neural3d.fields import SemanticSDF
 from neural3d.losses import psnr, total_loss
-from neural3d.model import render_rays
+from neural3d.model import RenderOutput, render_rays
 from neural3d.normalisation import Normalisation
+from neural3d.occupancy import OccupancyGrid
 from neural3d.trained import TrainedField, build_field
 
 LOG_EVERY = 10  # steps between log.csv rows
@@ -59,6 +65,73 @@ def lr_factor(step: int, config: TrainConfig) -> float:
     progress = min((step - config.warmup) / max(config.iterations - config.warmup, 1), 1.0)
     return config.lr_final_factor + (1 - config.lr_final_factor) * 0.5 * (
         1 + math.cos(math.pi * progress))
+
+
+def make_optimizer(field: torch.nn.Module, config: TrainConfig
+                   ) -> tuple[torch.optim.Adam, torch.optim.lr_scheduler.LambdaLR]:
+    """Adam over all of ``field``'s parameters and its warm-up + cosine schedule."""
+    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
+    return optimizer, torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor,
+                                                                           config=config))
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """One training step: the loss (detached), its weighted parts, the batch and its render."""
+
+    loss: float
+    parts: dict[str, float]
+    pixel_index: torch.Tensor  # "(R,)" rows of the pixels the batch used
+    render: RenderOutput
+
+
+@torch.no_grad()
+def update_ema(average: torch.nn.Module, field: torch.nn.Module, decay: float) -> None:
+    """``average`` <- decay * average + (1 - decay) * field (parameters); buffers copied."""
+    for a, p in zip(average.parameters(), field.parameters()):
+        a.lerp_(p, 1.0 - decay)
+    for a, b in zip(average.buffers(), field.buffers()):
+        a.copy_(b)
+
+
+def make_occupancy(config: TrainConfig, box_min: torch.Tensor, box_max: torch.Tensor
+                   ) -> OccupancyGrid | None:
+    """The run's occupancy grid over the box "(3,)", or None when ``occupancy_resolution`` is 0."""
+    if config.occupancy_resolution == 0:
+        return None
+    return OccupancyGrid(box_min, box_max, config.occupancy_resolution)
+
+
+def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
+               scheduler: torch.optim.lr_scheduler.LRScheduler | None, pixels: Pixels,
+               box_min: torch.Tensor, box_max: torch.Tensor, config: TrainConfig, *,
+               step: int, background_class: int, generator: torch.Generator,
+               occupancy: OccupancyGrid | None = None) -> StepResult:
+    """One optimisation step at ``step`` (the only training step; the bench calls it too).
+
+    Draws ``config.rays_per_batch`` pixels with ``generator``, renders them, takes
+    the weighted loss and one optimizer (and scheduler, if given) step. With an
+    ``occupancy`` grid, rays skip empty space; the grid is refreshed from the SDF
+    at ``occupancy_start`` and every ``occupancy_every`` steps after.
+    """
+    field.set_step(step)
+    if occupancy is not None and step >= config.occupancy_start and (
+            step - config.occupancy_start) % config.occupancy_every == 0:
+        occupancy.update_from_sdf(field.sdf, margin=config.occupancy_margin_cells * occupancy.cell)
+    idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
+                        device=pixels.rgb.device)
+    out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max, config,
+                      step=step, training=True, background_class=background_class,
+                      generator=generator, occupancy=occupancy)
+    depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
+    loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
+                             background_class=background_class, depth_t=depth_t)
+    optimizer.zero_grad(set_to_none=True)
+    loss.backward()
+    optimizer.step()
+    if scheduler is not None:
+        scheduler.step()
+    return StepResult(float(loss.detach()), parts, idx, out)
 
 
 def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.device,
@@ -100,60 +173,67 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     if eval_frames:
         chosen = load_frames(scene, "eval", image_scale=config.image_scale)
         pick = torch.linspace(0, len(chosen) - 1, min(config.eval_max_frames, len(chosen)))
-        eval_pixels = frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device)
+        eval_pixels = eval_pixel_subset(
+            frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device),
+            config.eval_rays_per_frame, seed=config.seed)
 
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
         field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
-    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
-    scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor, config=config))
+    optimizer, scheduler = make_optimizer(field, config)
+    average = None
+    if config.ema_decay > 0:
+        average = copy.deepcopy(field).requires_grad_(False)
     gen = torch.Generator(device=device).manual_seed(config.seed)
-    step, train_s, log_rows, evals = 0, 0.0, [], []
+    step, train_s, eval_s, log_rows, evals = 0, 0.0, 0.0, [], []
     if resume:
         state = read_checkpoint(run_dir / CHECKPOINT_NAME, device)
         field.load_state_dict(state["field"])
+        if average is not None:
+            average.load_state_dict(state.get("ema", state["field"]))
         optimizer.load_state_dict(state["optimizer"])
         scheduler.load_state_dict(state["scheduler"])
         gen.set_state(state["generator"].cpu())
         step, train_s = int(state["step"]), float(state["train_s"])
+        eval_s = float(state.get("eval_s", 0.0))
         log_rows = [r for r in _read_log(run_dir) if int(r["step"]) <= step]
         evals = [e for e in _read_evals(run_dir) if e["step"] <= step]
     box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     classes = tuple(scene.semantic_classes)
+    occupancy = make_occupancy(config, box_min, box_max)
+    measured = field if average is None else average
+    if resume and occupancy is not None and "occupancy" in state:
+        occupancy.occupied = state["occupancy"].to(device)
 
     def save() -> None:
         write_checkpoint(run_dir / CHECKPOINT_NAME, {
             "step": step, "field": field.state_dict(), "optimizer": optimizer.state_dict(),
             "scheduler": scheduler.state_dict(), "generator": gen.get_state(),
-            "train_s": train_s,
+            "train_s": train_s, "eval_s": eval_s,
+            **({} if occupancy is None else {"occupancy": occupancy.occupied}),
+            **({} if average is None else {"ema": average.state_dict()}),
         })
         _write_log(run_dir, log_rows)
 
     bar = tqdm(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
                dynamic_ncols=True, disable=None)
+    previous_sigterm = _sigterm_as_interrupt()
     try:
         while step < config.iterations:
             tic = time.perf_counter()
-            field.set_step(step)
-            idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=gen,
-                                device=device)
-            out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max,
-                              config, step=step, training=True, background_class=bg,
-                              generator=gen)
-            depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
-            loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
-                                     background_class=bg, depth_t=depth_t)
-            optimizer.zero_grad(set_to_none=True)
-            loss.backward()
-            optimizer.step()
-            scheduler.step()
+            result = train_step(field, optimizer, scheduler, pixels, box_min, box_max, config,
+                                step=step, background_class=bg, generator=gen,
+                                occupancy=occupancy)
+            if average is not None:
+                update_ema(average, field, config.ema_decay)
             step += 1
             train_s += time.perf_counter() - tic
             bar.update(1)
             if step % LOG_EVERY == 0 or step == config.iterations:
-                row = {"step": step, "train_s": round(train_s, 3), "loss": float(loss.detach()),
-                       **parts, "psnr": psnr(out.rgb.detach(), pixels.rgb[idx]),
+                row = {"step": step, "train_s": round(train_s, 3), "loss": result.loss,
+                       **result.parts,
+                       "psnr": psnr(result.render.rgb.detach(), pixels.rgb[result.pixel_index]),
                        "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0]}
                 log_rows.append(row)
                 _write_log(run_dir, log_rows)
@@ -163,15 +243,19 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
                 save()
             if step % config.eval_every == 0 or step == config.iterations or stop:
                 if eval_pixels is not None:
-                    figures = evaluate(field, eval_pixels, box_min, box_max, config, step=step,
+                    tic = time.perf_counter()
+                    figures = evaluate(measured, eval_pixels, box_min, box_max, config, step=step,
                                        background_class=bg)
-                    evals.append({"step": step, "train_s": round(train_s, 3), **figures})
+                    eval_s += time.perf_counter() - tic
+                    evals.append({"step": step, "train_s": round(train_s, 3),
+                                  "eval_s": round(eval_s, 3), "eval_rays": len(eval_pixels),
+                                  **figures})
                     write_json_atomic(run_dir / "eval.json", {"evaluations": evals})
                 if callback is not None:
-                    field.eval()
-                    answer = callback(step, TrainedField(field, norm, scene_dir=scene_dir,
+                    measured.eval()
+                    answer = callback(step, TrainedField(measured, norm, scene_dir=scene_dir,
                                                          class_names=classes))
-                    field.train()
+                    measured.train()
                     stop = stop or answer is True
             if stop:
                 break
@@ -180,8 +264,25 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         raise
     finally:
         bar.close()
+        if previous_sigterm is not None:
+            signal.signal(signal.SIGTERM, previous_sigterm)
     save()
     return run_dir
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def _sigterm_as_interrupt():
+    """Make SIGTERM raise KeyboardInterrupt (so it saves a checkpoint as Ctrl-C does).
+
+    Returns the previous handler to restore, or None off the main thread (where
+    Python cannot install handlers; such a caller handles its own signals).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _raise_interrupt)
 
 
 def _start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
@@ -263,6 +364,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-minutes", type=float, default=None,
                         help="stop after this many minutes of training (a checkpoint is kept)")
     parser.add_argument("--iterations", type=int, default=None, help="override the preset")
+    parser.add_argument("--eval-every", type=int, default=None,
+                        help="steps between held-out evaluations (override the preset)")
+    parser.add_argument("--eval-rays", type=int, default=None,
+                        help="random pixels scored per eval frame (0 = every pixel; preset "
+                             "default 1024); evaluation time is reported as eval_s")
     parser.add_argument("--depth-loss", action="store_true",
                         help="variant: also supervise rendered depth with the depth images")
     add_debug_flag(parser)
@@ -278,6 +384,10 @@ def main(argv: list[str] | None = None) -> int:
                 config = replace(config, iterations=args.iterations)
             if args.depth_loss:
                 config = replace(config, depth_loss=True)
+            if args.eval_every is not None:
+                config = replace(config, eval_every=args.eval_every)
+            if args.eval_rays is not None:
+                config = replace(config, eval_rays_per_frame=args.eval_rays)
         if args.max_minutes is not None and not args.max_minutes > 0:
             raise ValueError(f"--max-minutes must be > 0, got {args.max_minutes}")
         check_output_folder(args.out)

@@ -108,7 +108,7 @@ def load_trained_field(run_dir: Path, *, device: torch.device) -> TrainedField:
                          "the run again") from exc
     field = build_field(config.model, len(class_names), norm).to(device)
     state = read_checkpoint(run_dir / "checkpoint.pt", device)
-    field.load_state_dict(state["field"])
+    field.load_state_dict(state.get("ema", state["field"]))  # the averaged weights if any
     field.set_step(int(state["step"]))
     field.eval()
     return TrainedField(field, norm, scene_dir=scene_dir, class_names=class_names)

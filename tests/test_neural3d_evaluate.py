@@ -5,7 +5,7 @@ import torch
 
 from neural3d.config import preset_config
 from neural3d.data import Pixels
-from neural3d.evaluate import evaluate
+from neural3d.evaluate import eval_pixel_subset, evaluate
 from neural3d.fields import SemanticSDF
 
 
@@ -24,3 +24,18 @@ def test_all_sky_pixels():
     figures = evaluate(field, pixels, lo, hi, config, step=0, background_class=0)
     assert figures["psnr"] > 60  # exact colours: PSNR capped by the 1e-10 MSE floor at 100
     assert figures["semantic_accuracy"] == 1.0 and figures["mask_iou"] == 1.0
+
+
+def test_eval_pixel_subset_draws_the_same_pixels_of_every_frame():
+    shapes = ((4, 5), (2, 3))
+    n = 26
+    labels = torch.arange(n)
+    pixels = Pixels(origins=torch.zeros(n, 3), dirs=torch.zeros(n, 3), rgb=torch.zeros(n, 3),
+                    labels=labels, depth_t=None, shapes=shapes)
+    a = eval_pixel_subset(pixels, 4, seed=0)
+    b = eval_pixel_subset(pixels, 4, seed=0)
+    assert torch.equal(a.labels, b.labels) and a.shapes == ((1, 4), (1, 4))
+    assert (a.labels[:4] < 20).all() and (a.labels[4:] >= 20).all()  # 4 from each frame
+    assert len(set(a.labels.tolist())) == 8
+    assert eval_pixel_subset(pixels, 0, seed=0) is pixels  # 0: every pixel
+    assert len(eval_pixel_subset(pixels, 100, seed=0)) == n  # capped at the frame size

@@ -75,3 +75,13 @@ def test_bad_class_count():
 def test_skip_needs_a_wider_hidden_layer():
     with pytest.raises(ValueError, match="skip connection"):
         SemanticSDF(FieldConfig(backbone="mlp", mlp_hidden=32, mlp_skip=2), 6, *BOX)
+
+
+@pytest.mark.parametrize("backbone", ["mlp", "grid"])
+def test_input_encoding_keeps_x_first_and_has_a_schedule(backbone):
+    enc = make(backbone).sdf_net.encoding
+    x = torch.rand(5, 3) * 2 - 1
+    h = enc(x)
+    assert h.shape == (5, enc.out_dim)
+    torch.testing.assert_close(h[:, :3], x)
+    enc.set_step(0)  # both kinds follow the step; only the grid changes with it

@@ -165,3 +165,78 @@ def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
     run = train(scene, config, tmp_path, device=CPU)
     field = load_trained_field(run, device=CPU)
     assert torch.isfinite(field.sdf_m(torch.zeros(4, 3))).all()
+
+
+def test_train_step_is_the_only_training_step():
+    """bench/neural3d.py calls neural3d.train.train_step; it has no loss/backward of its own."""
+    from pathlib import Path
+
+    bench = (Path(__file__).resolve().parent.parent / "bench" / "neural3d.py").read_text()
+    assert "train_step(" in bench
+    for copy in ("total_loss", ".backward(", "render_rays", "torch.optim.Adam"):
+        assert copy not in bench, f"bench/neural3d.py has its own {copy}"
+
+
+def test_sigterm_saves_a_checkpoint_like_ctrl_c(scene, tmp_path):
+    """The CLI run is killed with SIGTERM mid-training; its checkpoint is there to resume."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    env = {**os.environ, "PYTHONPATH": str(root), "OMP_NUM_THREADS": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "neural3d.train", "--scene", str(scene), "--preset", "tiny",
+         "--iterations", "100000", "--out", str(tmp_path)],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    log = tmp_path / "box" / "log.csv"
+    deadline = time.monotonic() + 120
+    while not (log.is_file() and len(log.read_text().splitlines()) > 2):  # >= 20 steps done
+        assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read()
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "checkpoint saved" in err
+    assert read_checkpoint(tmp_path / "box" / "checkpoint.pt", CPU)["step"] >= 20
+
+
+def test_training_with_occupancy_grid_refreshes_and_checkpoints_it(scene, tmp_path):
+    config = replace(preset_config("tiny"), iterations=6, rays_per_batch=32, eval_every=6,
+                     checkpoint_every=6, occupancy_resolution=16, occupancy_start=2,
+                     occupancy_every=2)
+    run = train(scene, config, tmp_path, device=CPU)
+    state = read_checkpoint(run / "checkpoint.pt", CPU)
+    occupied = state["occupancy"]
+    assert occupied.dtype == torch.bool and 0 < occupied.float().mean() < 1  # refreshed
+
+
+def test_update_ema_is_the_exponential_average():
+    from neural3d.train import update_ema
+
+    average, field = torch.nn.Linear(2, 1), torch.nn.Linear(2, 1)
+    with torch.no_grad():
+        for p in average.parameters():
+            p.fill_(0.0)
+        for p in field.parameters():
+            p.fill_(1.0)
+    for _ in range(3):
+        update_ema(average, field, 0.5)
+    assert torch.allclose(average.weight, torch.full((1, 2), 0.875))  # 1 - 0.5^3
+
+
+def test_training_with_ema_checkpoints_and_loads_the_averaged_field(scene, tmp_path):
+    config = replace(preset_config("tiny"), iterations=4, rays_per_batch=16, eval_every=4,
+                     checkpoint_every=4, ema_decay=0.5)
+    seen = []
+    run = train(scene, config, tmp_path, device=CPU,
+                callback=lambda s, f: seen.append(f.field.state_dict()["log_inv_s"].item()))
+    state = read_checkpoint(run / "checkpoint.pt", CPU)
+    assert state["ema"].keys() == state["field"].keys()
+    table = "sdf_net.encoding.grid.table"
+    assert not torch.equal(state["ema"][table], state["field"][table])
+    loaded = load_trained_field(run, device=CPU).field.state_dict()
+    assert torch.equal(loaded[table], state["ema"][table])
+    assert seen == [state["ema"]["log_inv_s"].item()]  # the callback measured the average
