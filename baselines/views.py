@@ -14,7 +14,8 @@ from typing import Literal
 import numpy as np
 
 from dataset.camera import Intrinsics
-from dataset.images import read_depth_m, read_labels
+from dataset.images import read_depth_m
+from dataset.labels import read_frame_labels
 from dataset.scene import Frame, Scene
 
 Protocol = Literal["ideal", "multi"]
@@ -139,7 +140,7 @@ def _read_labels(scene: Scene, frame: Frame) -> np.ndarray:
     if frame.semantic_file_path is None:
         raise ViewError("the frame has no semantic_file_path (semantic mask) in transforms.json")
     try:
-        labels = read_labels(scene.path(frame.semantic_file_path))
+        labels = read_frame_labels(scene, frame)
     except ValueError as exc:
         raise ViewError(str(exc)) from exc
     _check_size(labels, frame, frame.semantic_file_path)

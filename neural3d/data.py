@@ -15,12 +15,12 @@ import torch
 from torch import Tensor
 
 from dataset.camera import Intrinsics, rays_world
-from dataset.images import read_depth_m, read_labels, read_rgb
+from dataset.classes import SemanticClass
+from dataset.images import read_depth_m, read_rgb
+from dataset.labels import read_frame_labels
 from dataset.scene import Scene, Split
 from neural3d.normalisation import Normalisation
 from neural3d.scene_box import visual_hull_box_m
-
-BACKGROUND_NAME = "background"
 
 
 @dataclass(frozen=True)
@@ -59,12 +59,9 @@ class Pixels:
 
 
 def background_class(scene: Scene) -> int:
-    """Index of the background class in the scene's class list."""
-    names = [n.lower() for n in scene.semantic_classes]
-    if BACKGROUND_NAME not in names:
-        raise ValueError(f"scene {scene.root} has no 'background' class in its semantic "
-                         f"classes {scene.semantic_classes}")
-    return names.index(BACKGROUND_NAME)
+    """Our background class id: :func:`dataset.labels.read_frame_labels` gives every frame's
+    labels in the project's ids (:data:`dataset.classes.CLASS_NAMES`), whatever the scene holds."""
+    return int(SemanticClass.BACKGROUND)
 
 
 def load_frames(scene: Scene, split: Split, *, image_scale: float = 1.0,
@@ -90,7 +87,7 @@ def load_frames(scene: Scene, split: Split, *, image_scale: float = 1.0,
             raise ValueError(f"frame {fr.file_path} has no depth_file_path (needed by "
                              "depth_loss); train without --depth-loss")
         rgb = read_rgb(scene.path(fr.file_path))
-        labels = read_labels(scene.path(fr.semantic_file_path))
+        labels = read_frame_labels(scene, fr)
         depth = (read_depth_m(scene.path(fr.depth_file_path), scene.depth_unit_scale_factor)
                  if with_depth else None)
         k = fr.intrinsics
@@ -100,9 +97,6 @@ def load_frames(scene: Scene, split: Split, *, image_scale: float = 1.0,
                     f"{name} of frame {fr.file_path} is {img.shape[1]}x{img.shape[0]} but its "
                     f"intrinsics say {k.width}x{k.height}: fix transforms.json or the image"
                 )
-        if labels.max() >= len(scene.semantic_classes):
-            raise ValueError(f"semantic mask of {fr.file_path} holds class {labels.max()} but "
-                             f"the scene lists {len(scene.semantic_classes)} classes")
         if image_scale != 1.0:
             k = k.scaled(image_scale)
             size = (k.width, k.height)

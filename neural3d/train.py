@@ -25,6 +25,7 @@ import torch
 from tqdm import tqdm
 
 from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.classes import CLASS_NAMES
 from dataset.device import resolve_device
 from dataset.results import code_version
 from dataset.scene import read_scene
@@ -86,7 +87,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         norm = _check_resumable(run_dir, config)
     else:
         norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
-        _start_run_folder(run_dir, scene_dir, scene.semantic_classes, bg, norm, config, device,
+        _start_run_folder(run_dir, scene_dir, CLASS_NAMES, bg, norm, config, device,
                           len(frames))
     pixels = frames_to_pixels(frames, norm, device)
     eval_pixels = None
@@ -98,7 +99,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
 
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
-        field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
+        field = build_field(config.model, len(CLASS_NAMES), norm).to(device)
     optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor, config=config))
     gen = torch.Generator(device=device).manual_seed(config.seed)
@@ -114,7 +115,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         evals = [e for e in _read_evals(run_dir) if e["step"] <= step]
     box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
-    classes = tuple(scene.semantic_classes)
+    classes = tuple(CLASS_NAMES)
 
     def save() -> None:
         write_checkpoint(run_dir / CHECKPOINT_NAME, {
