@@ -163,6 +163,10 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     src.add_argument("--mesh", type=Path, metavar="FILE",
                      help="your labelled mesh (.ply with per-face label, or .obj/.glb with "
                           "class-named parts), metres, z up; see docs/importing.md")
+    src.add_argument("--buildnet3d", type=Path, metavar="PATH",
+                     help="BuildNet3D-dataset generator output (its root, or one "
+                          "images/building<i> folder): one scene per building, as rendered "
+                          "(render options are ignored); see docs/importing.md")
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
     p.add_argument("--resolution", type=int, default=d.resolution,
@@ -195,7 +199,11 @@ def main(argv: list[str] | None = None) -> int:
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
             fov_deg=args.fov, supersampling=args.supersampling,
         )
-        if args.preset is not None:
+        if args.buildnet3d is not None:
+            from dataset.buildnet3d import import_buildnet3d
+
+            scenes = import_buildnet3d(args.buildnet3d, args.out, overwrite=args.overwrite)
+        elif args.preset is not None:
             scenes = generate_preset(args.preset, args.out, config, workers=args.workers,
                                      seed=args.seed, overwrite=args.overwrite,
                                      progress=not args.quiet)
