@@ -199,6 +199,10 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--ifc-classes", type=Path, metavar="JSON",
                    help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
                         '{"IfcCovering": "wall", "IfcRailing": "skip"}')
+    src.add_argument("--buildnet3d", type=Path, metavar="PATH",
+                     help="BuildNet3D-dataset generator output (its root, or one "
+                          "images/building<i> folder): one scene per building, as rendered "
+                          "(render options are ignored); see docs/importing.md")
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
     p.add_argument("--resolution", type=int, default=d.resolution,
@@ -242,8 +246,12 @@ def main(argv: list[str] | None = None) -> int:
             raise ValueError("--executor ray renders a preset's buildings as tasks; with --mesh "
                              "use --workers to split one building's frames over processes")
         check_output_folder(args.out)
-        _check_resources(args, config)
-        if args.preset is not None:
+        if args.buildnet3d is not None:
+            from dataset.buildnet3d import import_buildnet3d
+
+            scenes = import_buildnet3d(args.buildnet3d, args.out, overwrite=args.overwrite)
+        elif args.preset is not None:
+            _check_resources(args, config)
             ray = RayConfig(address=args.ray_address) if args.executor == "ray" else None
             scenes = generate_preset(args.preset, args.out, config, workers=args.workers,
                                      seed=args.seed, overwrite=args.overwrite,

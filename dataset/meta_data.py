@@ -13,8 +13,9 @@ sdfstudio's file: top-level ``camera_model``, ``height``, ``width``, ``has_mono_
   Blender poses, its converter copies nerfstudio's ``transform_matrix``) and finds
   ``rgb_path`` under ``images/`` and ``segmentation_path`` under ``semantic/``.
 
-Segmentation images keep the source's class ids (or colours) on disk;
-:func:`remap_labels` turns them into ours (:mod:`dataset.classes`).
+Segmentation images keep the source's class ids (or colours) on disk, and the scene
+declares the source's class list, so :func:`dataset.labels.read_frame_labels` remaps them
+(:mod:`dataset.labels`).
 """
 
 from __future__ import annotations
@@ -28,12 +29,17 @@ import numpy as np
 
 from dataset.atomic import write_json_atomic
 from dataset.camera import Intrinsics
-from dataset.classes import CLASS_NAMES, SemanticClass
+from dataset.labels import (  # noqa: F401  (re-exported: the mappings lived here)
+    ClassIds,
+    ClassMapping,
+    class_mapping,
+    read_remapped_labels,
+    remap_labels,
+)
 from dataset.scene import DEFAULT_DEPTH_UNIT_M, SPLITS, Frame, Scene
 from dataset.scene_validation import validate_scene
 
 PoseConvention = Literal["opencv", "opengl"]
-ClassIds = Literal["renderer", "generator", "envelope_bench"]
 META_DATA_FILE = "meta_data.json"
 OPENCV_FROM_OPENGL = np.diag([1.0, -1.0, -1.0, 1.0])
 """Right-multiply a camera-to-world pose by this to swap OpenGL <-> OpenCV camera axes."""
@@ -65,108 +71,6 @@ BUILDNET3D_LAYOUT = MetaDataLayout(
 )
 
 
-@dataclass(frozen=True)
-class ClassMapping:
-    """A source's class ids and mask colours, and our class for each.
-
-    ``names[i]``, ``to_ours[i]`` and ``colours[i]`` (RGB, 0-255) describe source id ``i``;
-    ``colours`` is ``None`` when the source never writes colour-coded masks.
-    """
-
-    source: ClassIds
-    names: tuple[str, ...]
-    to_ours: tuple[int, ...]
-    colours: tuple[tuple[int, int, int], ...] | None
-
-
-_B, _WA, _WI, _R, _D, _O = (int(c) for c in SemanticClass)
-_MAPPINGS: dict[str, ClassMapping] = {
-    # EPFL-IMOS/buildnet3d BlenderProc renderer (bproc_generator/render/generate.py): the public
-    # BuildNet3D image data. Vegetation, vehicles and furniture are not the envelope.
-    "renderer": ClassMapping(
-        "renderer",
-        ("background", "wall", "door", "window", "roof", "chimney",
-         "vegetation", "vehicle", "furniture", "misc"),
-        (_B, _WA, _D, _WI, _R, _O, _B, _B, _B, _O),
-        ((0, 0, 0), (175, 200, 0), (0, 200, 200), (125, 0, 200), (175, 0, 200),
-         (0, 50, 200), (0, 200, 50), (150, 50, 50), (50, 175, 50), (50, 50, 175)),
-    ),
-    # Schindler-EPFL-Lab/BuildNet3D-dataset procedural generator (config/segmentation_config.json).
-    "generator": ClassMapping(
-        "generator",
-        ("background", "wall", "window", "roof"),
-        (_B, _WA, _WI, _R),
-        ((0, 0, 0), (177, 206, 0), (0, 206, 206), (177, 0, 206)),
-    ),
-    # Our own scenes exported with write_meta_data: ids are already ours.
-    "envelope_bench": ClassMapping(
-        "envelope_bench", CLASS_NAMES, tuple(range(len(CLASS_NAMES))), None
-    ),
-}
-
-
-def class_mapping(class_ids: ClassIds) -> ClassMapping:
-    """The :class:`ClassMapping` of ``"renderer"``, ``"generator"`` or ``"envelope_bench"``."""
-    if class_ids not in _MAPPINGS:
-        raise ValueError(
-            f"unknown class_ids {class_ids!r}; choose one of {', '.join(_MAPPINGS)}"
-        )
-    return _MAPPINGS[class_ids]
-
-
-def remap_labels(labels: np.ndarray, mapping: ClassMapping) -> np.ndarray:
-    """A source's label image in our class ids.
-
-    Parameters
-    ----------
-    labels : (H, W) int, or (H, W, 3) / (H, W, 4) uint8 colour-coded mask
-        Source class ids, or the source's mask colours (alpha ignored).
-    mapping
-        From :func:`class_mapping`.
-
-    Returns
-    -------
-    (H, W) uint8 our class ids.
-
-    Raises
-    ------
-    ValueError
-        An id or colour the source does not define, or a colour mask for a source without
-        colours.
-    """
-    a = np.asarray(labels)
-    if a.ndim == 3 and a.shape[2] in (3, 4):
-        a = _ids_from_colours(a[..., :3], mapping)
-    elif a.ndim != 2:
-        raise ValueError(f"labels must be (H, W) ids or (H, W, 3) colours, got shape {a.shape}")
-    if not np.issubdtype(a.dtype, np.integer):
-        raise ValueError(f"label ids must be integers, got dtype {a.dtype}")
-    lut = np.asarray(mapping.to_ours, dtype=np.uint8)
-    bad = (a < 0) | (a >= len(lut))
-    if bad.any():
-        raise ValueError(
-            f"label image holds ids {sorted(set(np.unique(a[bad]).tolist()))[:10]} that the "
-            f"{mapping.source!r} classes (0..{len(lut) - 1}: {', '.join(mapping.names)}) do "
-            "not define; pick the class_ids the data was made with"
-        )
-    return lut[a]
-
-
-def read_remapped_labels(path: str | Path, mapping: ClassMapping) -> np.ndarray:
-    """(H, W) uint8 our class ids of a source's segmentation PNG (ids or colour-coded).
-
-    Single-channel (and palette) images hold ids; RGB(A) images are colour-coded masks.
-    """
-    from PIL import Image
-
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"segmentation image {path} does not exist")
-    with Image.open(path) as img:
-        labels = np.asarray(img.convert("RGB") if img.mode == "RGBA" else img)
-    return remap_labels(labels, mapping)
-
-
 def read_meta_data(
     path: str | Path,
     *,
@@ -195,8 +99,10 @@ def read_meta_data(
     -------
     scene
         Frames with OpenGL ``world_from_camera`` and paths relative to the file's folder
-        (segmentation images still in the source's ids); split ``train`` unless a frame
-        says otherwise. ``extra`` keeps ``scene_box``, ``worldtogt`` and other top-level keys.
+        (segmentation images still in the source's ids, and ``semantic_classes`` the
+        source's class names, so :func:`dataset.labels.read_frame_labels` remaps them);
+        split ``train`` unless a frame says otherwise. ``extra`` keeps ``scene_box``,
+        ``worldtogt`` and other top-level keys.
     mapping
         The :class:`ClassMapping` to pass to :func:`remap_labels`.
 
@@ -227,6 +133,7 @@ def read_meta_data(
     scene = Scene(
         root=file.parent,
         frames=frames,
+        semantic_classes=mapping.names,
         depth_unit_scale_factor=float(meta.get("depth_unit_scale_factor", DEFAULT_DEPTH_UNIT_M)),
         extra={k: v for k, v in meta.items() if k not in known},
     )
@@ -384,32 +291,3 @@ def _strip(folder: str, path: str) -> str:
             f"{path} is not inside {folder}/, which this layout requires; move the file or "
             "use SDFSTUDIO_LAYOUT (paths relative to the scene folder)"
         ) from None
-
-
-def _ids_from_colours(rgb: np.ndarray, mapping: ClassMapping) -> np.ndarray:
-    """(H, W) int64 source ids of a colour-coded (H, W, 3) mask."""
-    if mapping.colours is None:
-        raise ValueError(
-            f"the {mapping.source!r} classes have no mask colours; pass a single-channel "
-            "label image of class ids"
-        )
-    if rgb.dtype != np.uint8:
-        raise ValueError(f"colour masks must be uint8 RGB, got dtype {rgb.dtype}")
-    key = _pack(rgb.astype(np.int64))
-    palette = _pack(np.asarray(mapping.colours, dtype=np.int64))
-    order = np.argsort(palette)
-    pos = np.clip(np.searchsorted(palette[order], key), 0, len(palette) - 1)
-    ids = order[pos]
-    bad = palette[ids] != key
-    if bad.any():
-        colours = np.unique(rgb[bad].reshape(-1, 3), axis=0)[:5].tolist()
-        raise ValueError(
-            f"mask holds colours {colours} that the {mapping.source!r} palette does not "
-            "define; pick the class_ids the data was made with (masks must be saved "
-            "without anti-aliasing or lossy compression)"
-        )
-    return ids
-
-
-def _pack(rgb: np.ndarray) -> np.ndarray:
-    return (rgb[..., 0] << 16) | (rgb[..., 1] << 8) | rgb[..., 2]

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from dataset.images import read_depth_m, read_labels
+from dataset.labels import mapping_for_classes, read_remapped_labels
 
 if TYPE_CHECKING:
     from dataset.scene import Frame, Scene
@@ -102,7 +103,11 @@ def resolve_inside(root: Path, relative: str) -> Path:
 
 
 def read_frame_labels(scene: Scene, frame: Frame) -> np.ndarray:
-    """(H, W) uint8 class ids of ``frame``'s semantic image, checked against the scene.
+    """(H, W) uint8 project class ids of ``frame``'s semantic image, checked against the scene.
+
+    The one way methods read labels: a scene that declares the project's classes
+    holds our ids (checked); one that declares a known source's classes
+    (:mod:`dataset.labels`) is remapped to ours; any other class list is refused.
 
     Raises
     ------
@@ -118,10 +123,14 @@ def read_frame_labels(scene: Scene, frame: Frame) -> np.ndarray:
                          "in transforms.json")
     path = scene.path(frame.semantic_file_path)
     try:
-        labels = read_labels(path)
+        mapping = mapping_for_classes(scene.semantic_classes)
+        # A scene read from a source (meta_data.json) holds that source's ids or colours.
+        labels = read_labels(path) if mapping is None else read_remapped_labels(path, mapping)
     except ValueError as exc:
         raise InvalidSceneError(str(exc)) from exc
     _check_shape(labels, frame, frame.semantic_file_path)
+    if mapping is not None:
+        return labels  # remapped: unknown source ids or colours were refused on the way
     n = len(scene.semantic_classes)
     counts = np.bincount(labels.ravel(), minlength=256)
     unknown = np.flatnonzero(counts[n:]) + n

@@ -15,13 +15,12 @@ import torch
 from torch import Tensor
 
 from dataset.camera import Intrinsics, rays_world
+from dataset.classes import SemanticClass
 from dataset.images import read_rgb
 from dataset.scene import Scene, Split
 from dataset.scene_validation import read_frame_depth_m, read_frame_labels
 from neural3d.normalisation import Normalisation
 from neural3d.scene_box import visual_hull_box_m
-
-BACKGROUND_NAME = "background"
 
 
 @dataclass(frozen=True)
@@ -60,12 +59,10 @@ class Pixels:
 
 
 def background_class(scene: Scene) -> int:
-    """Index of the background class in the scene's class list."""
-    names = [n.lower() for n in scene.semantic_classes]
-    if BACKGROUND_NAME not in names:
-        raise ValueError(f"scene {scene.root} has no 'background' class in its semantic "
-                         f"classes {scene.semantic_classes}")
-    return names.index(BACKGROUND_NAME)
+    """Our background class id: :func:`dataset.scene_validation.read_frame_labels` gives
+    every frame's labels in the project's ids (:data:`dataset.classes.CLASS_NAMES`), whatever
+    the scene holds."""
+    return int(SemanticClass.BACKGROUND)
 
 
 def load_frames(scene: Scene, split: Split, *, image_scale: float = 1.0,

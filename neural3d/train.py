@@ -28,6 +28,7 @@ import torch
 from tqdm import tqdm
 
 from dataset.atomic import write_json_atomic, write_text_atomic
+from dataset.classes import CLASS_NAMES
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.device import resolve_device
 from dataset.resources import check_training_resources
@@ -165,7 +166,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         norm = _check_resumable(run_dir, config)
     else:
         norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
-        _start_run_folder(run_dir, scene_dir, scene.semantic_classes, bg, norm, config, device,
+        _start_run_folder(run_dir, scene_dir, CLASS_NAMES, bg, norm, config, device,
                           len(frames))
     pixels = frames_to_pixels(frames, norm, device)
     eval_pixels = None
@@ -179,7 +180,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
 
     with torch.random.fork_rng(devices=[]):
         torch.manual_seed(config.seed)
-        field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
+        field = build_field(config.model, len(CLASS_NAMES), norm).to(device)
     optimizer, scheduler = make_optimizer(field, config)
     average = None
     if config.ema_decay > 0:
@@ -200,7 +201,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         evals = [e for e in _read_evals(run_dir) if e["step"] <= step]
     box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
-    classes = tuple(scene.semantic_classes)
+    classes = tuple(CLASS_NAMES)
     occupancy = make_occupancy(config, box_min, box_max)
     measured = field if average is None else average
     if resume and occupancy is not None and "occupancy" in state:

@@ -54,5 +54,6 @@ def test_missing_split_and_class_errors(scene):
         load_frames(scene, "multi")
     from dataclasses import replace
 
-    with pytest.raises(ValueError, match="no 'background' class"):
-        background_class(replace(scene, semantic_classes=("sky", "wall")))
+    with pytest.raises(ValueError, match="neither the project's"):
+        load_frames(replace(scene, semantic_classes=("sky", "wall")), "train")
+    assert background_class(scene) == 0
