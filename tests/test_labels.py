@@ -32,7 +32,7 @@ def test_a_renderer_scene_keeps_its_windows_windows(tmp_path):
 def test_ids_beyond_our_classes_are_an_error_not_a_misreading(tmp_path):
     scene, frame = _scene(tmp_path, np.array([[9, 1], [4, 0]], np.uint8),
                           class_mapping("envelope_bench").names)
-    with pytest.raises(ValueError, match="another source's ids"):
+    with pytest.raises(ValueError, match=r"does not declare \(id 9 on 1 pixels\)"):
         read_frame_labels(scene, frame)
     with pytest.raises(ValueError, match="neither the project's"):
         read_frame_labels(replace(scene, semantic_classes=("sky", "wall")), frame)
