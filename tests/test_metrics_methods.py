@@ -1,7 +1,6 @@
 """Method wiring: names checked, configs recorded, read-only specs import nothing."""
 
 from dataclasses import asdict
-from pathlib import Path
 
 import pytest
 

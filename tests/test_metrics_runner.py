@@ -1,4 +1,4 @@
-"""Running only what is missing: reuse by provenance, recompute on change or corruption, failures."""
+"""Running only what is missing: reuse by provenance, recompute on change or corruption."""
 
 from dataclasses import replace
 from pathlib import Path
