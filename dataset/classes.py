@@ -19,6 +19,11 @@ class SemanticClass(IntEnum):
 
 
 NUM_CLASSES = len(SemanticClass)
+CLASS_RGB: tuple[tuple[int, int, int], ...] = (
+    (0, 0, 0), (200, 200, 200), (40, 110, 230), (170, 60, 50), (140, 90, 40), (60, 160, 70),
+)
+"""Display colour (RGB, 0-255) of each class id, in id order: the one palette of figures,
+debug images and the HTML report."""
 CLASS_NAMES: tuple[str, ...] = tuple(c.name.lower() for c in SemanticClass)
 FACADE_CLASSES: tuple[SemanticClass, ...] = (
     SemanticClass.WALL,

@@ -4,13 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from dataset.classes import CLASS_RGB as _CLASS_RGB
 from dataset.classes import NUM_CLASSES
 
-# RGB of class ids 0..5: background, wall, window, roof, door, other (as in the debug images).
-CLASS_RGB = np.array(
-    [(0, 0, 0), (200, 200, 200), (40, 110, 230), (170, 60, 50), (140, 90, 40), (60, 160, 70)],
-    dtype=np.uint8,
-)
+CLASS_RGB = np.array(_CLASS_RGB, dtype=np.uint8)  # (NUM_CLASSES, 3): dataset.classes.CLASS_RGB
 UNKNOWN_CLASS_RGB = (255, 0, 255)  # ids beyond the known classes stand out
 
 

@@ -6,7 +6,8 @@ for a short CPU budget). With ``--data`` it compares on a benchmark or a
 user's scenes. Outputs (``--out``): the tables as CSV, Markdown and LaTeX,
 per-building and per-facade CSVs, plots (PNG + PDF), ``provenance.json``, the
 estimated footprints, the 2D-SS pipeline images of one facade and
-``neural3d_runs.json`` pointing at neural3d's meshes: everything ``figures.make`` reads.
+``neural3d_runs.json`` pointing at neural3d's meshes: everything ``figures.make`` reads;
+then ``report.html``, all of it in one offline page (:mod:`metrics.html_report`).
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from metrics.errors import (
 from metrics.errors import failed_building as failed_row
 from metrics.executors import EXECUTORS, make_executor
 from metrics.explain import explain, methods_provenance_text, run_timings
+from metrics.html_report import write_report
 from metrics.methods import (
     METHODS,
     VIEW_PROTOCOLS,
@@ -133,6 +135,7 @@ def compare(
     if allow_run and any(s.name == "2D-SS" for s in specs):
         _keep_pipeline_images(scene_dirs, specs, out_dir / PIPELINE_FOLDER)
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
+    _write_html_report(out_dir)
     return comparison
 
 
@@ -191,6 +194,14 @@ def _provenance(
             for o in outcomes
         ],
     }
+
+
+def _write_html_report(out_dir: Path) -> None:
+    """``report.html`` from what was just written; a failure warns, the comparison stands."""
+    try:
+        write_report(out_dir)
+    except Exception as exc:  # the page is a view of the outputs, not one of them
+        print(f"warning: report.html not written: {type(exc).__name__}: {exc}", file=sys.stderr)
 
 
 def _write_plots(groups, rows, folder: Path) -> None:
