@@ -365,8 +365,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             resolve_device(args.device)  # a Ray cluster's GPUs are on its nodes, not here
         execute = make_executor(args.executor, RayConfig(address=args.ray_address))
         default = DefaultBenchmark() if args.data is None else None
-        resolution = args.neural3d_resolution or (default.neural3d_resolution if default else None)
-        steps = args.neural3d_steps or (default.neural3d_steps if default else None)
+        resolution = _given_or(args.neural3d_resolution,
+                               default.neural3d_resolution if default else None)
+        steps = _given_or(args.neural3d_steps, default.neural3d_steps if default else None)
         budget = Neural3dBudget(
             preset=args.neural3d_preset, steps=steps, max_minutes=args.neural3d_max_minutes,
             threads=args.neural3d_threads, resolution=resolution,
@@ -412,6 +413,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     return run_cli("metrics.compare", body, debug=args.debug, interrupted=(
         "interrupted: finished results are kept; run again to continue"))
+
+
+def _given_or(given: int | None, fallback: int | None) -> int | None:
+    """A CLI value when given (0 included, so that the budget refuses it), else the fallback."""
+    return fallback if given is None else given
 
 
 def _explain(args: argparse.Namespace, default: DefaultBenchmark | None,
