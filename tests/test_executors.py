@@ -181,7 +181,7 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
     def slow_run(scene_dir, protocol):
         if scene_dir.name == slow_scene:
             started.touch()
-            time.sleep(60)
+            time.sleep(120)
             finished.touch()
         return replace(quick.run(scene_dir, protocol), method="slow")
 
@@ -189,20 +189,23 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
     others = [results / f"{s.name}__{m}__ideal.json" for s in scenes for m in ("2D-S", "slow")
               if (s.name, m) != (slow_scene, "slow")]
 
+    sent = {}
+
     def interrupt_when_only_the_slow_task_is_left():
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + 110
         while time.monotonic() < deadline:
             if started.exists() and all(p.exists() for p in others):
+                sent["at"] = time.monotonic()
                 os.kill(os.getpid(), signal.SIGINT)  # what Ctrl-C in a terminal sends
                 return
             time.sleep(0.05)
 
     threading.Thread(target=interrupt_when_only_the_slow_task_is_left, daemon=True).start()
-    start = time.monotonic()
     with pytest.raises(KeyboardInterrupt):
         run_missing(scenes, [quick, slow], results, log=_quiet,
                     execute=make_executor("ray", CONFIG))
-    assert time.monotonic() - start < 50  # the slow task did not run to its end
+    # The interrupt ended the run at once: the slow task (120 s) did not run to its end.
+    assert time.monotonic() - sent["at"] < 30
     assert sorted(results.iterdir()) == sorted(others)  # no temporary or partial file
     for path in others:
         read_result(path)
@@ -220,10 +223,10 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
 
 def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     """``python -m metrics.compare --executor ray`` (its own Ray) gets SIGINT after its first
-    result, while neural3d (5 minutes per building) still runs or waits."""
+    result, while neural3d (100000 steps per building) still runs or waits."""
     results = tmp_path / "results"
     command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
-               "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-minutes", "5",
+               "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-steps", "100000",
                "--results", str(results), "--out", str(tmp_path / "out"), "--executor", "ray"]
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120

@@ -21,7 +21,7 @@ def test_methods_run_on_an_imported_ifc_scene(tmp_path):
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         code = compare(["--data", str(data), "--methods", "2D-S,2D-SS,neural3d",
                         "--views", "ideal", "--neural3d-preset", "tiny",
-                        "--neural3d-minutes", "10", "--neural3d-resolution", "32",
+                        "--neural3d-steps", "150", "--neural3d-resolution", "32",
                         "--out", str(tmp_path / "out")])
     assert code == 0
     rows = read_csv_rows((tmp_path / "out" / "table2_errors.csv").read_text())
