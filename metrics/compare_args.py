@@ -1,0 +1,94 @@
+"""The command line of ``python -m metrics.compare``: its options, their help and defaults."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from pathlib import Path
+
+from dataset.cli_errors import add_debug_flag
+from dataset.degrade.spec import DEGRADATIONS
+from dataset.protocols import VIEW_PROTOCOLS
+from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
+from metrics.executors import EXECUTORS
+from metrics.methods import METHODS, Neural3dBudget
+
+
+def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    """The options of ``python -m metrics.compare`` (``--help`` explains each)."""
+    parser = argparse.ArgumentParser(
+        prog="python -m metrics.compare",
+        description=(
+            "Compare WWR / window / facade-area and footprint estimates of 2D-S, 2D-SS and "
+            "neural3d against ground truth, running only the results that are missing. "
+            "Without --data it runs the built-in default: the tiny benchmark (generated into "
+            f"{DEFAULT_CACHE}), all methods, about 12 minutes on 2 CPU cores. Prints Table 2 "
+            "(errors per family) and Table 3 (footprint IoU) and writes them as CSV, Markdown "
+            "and LaTeX with plots and provenance.json into --out."
+        ),
+    )
+    parser.add_argument("--data", type=Path, help="a scene folder or a folder of scene folders "
+                        "(default: the built-in tiny benchmark)")
+    parser.add_argument("--methods", default=",".join(METHODS),
+                        help=f"comma-separated methods (default: {','.join(METHODS)})")
+    parser.add_argument("--views", default=",".join(VIEW_PROTOCOLS),
+                        help="comma-separated view protocols of the 2D methods "
+                        "(default: ideal,multi); neural3d always uses its train views")
+    parser.add_argument("--results", type=Path,
+                        help="folder of result JSONs to read and fill (default: <data>-results)")
+    parser.add_argument("--out", type=Path,
+                        help="folder for tables, plots, provenance (default: <data>-compare)")
+    parser.add_argument("--neural3d-steps", type=int,
+                        help="training steps per building for neural3d: the budget that fixes "
+                        "its result (default: the preset's own; the built-in default run uses "
+                        f"{DefaultBenchmark.neural3d_steps})")
+    parser.add_argument("--neural3d-max-minutes", type=float, default=Neural3dBudget.max_minutes,
+                        help="safety cap on neural3d's training time per building, minutes; a "
+                        "run it stops is marked 'cut short' in every table "
+                        f"(default: {Neural3dBudget.max_minutes:g})")
+    parser.add_argument("--neural3d-threads", type=int, default=Neural3dBudget.threads,
+                        help="torch CPU threads for neural3d (recorded with the result; "
+                        f"default: {Neural3dBudget.threads})")
+    parser.add_argument("--neural3d-preset", default=Neural3dBudget.preset,
+                        choices=("paper", "fast", "tiny"), help="neural3d training preset")
+    parser.add_argument("--neural3d-resolution", type=int,
+                        help="marching-cubes samples along the scene box's longest side "
+                        "(default: neural3d's own; the built-in default run uses "
+                        f"{DefaultBenchmark.neural3d_resolution})")
+    parser.add_argument("--device", default="cpu",
+                        help="torch device for neural3d: cpu or cuda (default: cpu)")
+    parser.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
+                        help="compare on degraded inputs (truth unchanged): "
+                        f"{', '.join(DEGRADATIONS)}; see dataset/degrade/spec.py. Degraded "
+                        "scenes are cached in <data>-degraded/, results go to "
+                        "<results>/degraded/, outputs to <out>-<key>")
+    parser.add_argument("--degrade-seed", type=int, default=0,
+                        help="seed of the degradations (default: 0)")
+    parser.add_argument("--robustness", action="store_true",
+                        help="run the robustness study (mask noise, occluders, pose and depth "
+                        "noise at three severities each; results in <results>/robustness, "
+                        "table and plot in <out>/robustness)")
+    parser.add_argument("--robustness-neural3d", choices=("all", "max"), default="max",
+                        help="robustness study: neural3d at every severity or only at the "
+                        "highest of each degradation (default: max)")
+    parser.add_argument("--no-run", action="store_true",
+                        help="only read existing result files; never run a method (results "
+                        "made by other code or settings are marked stale)")
+    parser.add_argument("--reuse-stale", action="store_true",
+                        help="keep stored results made by other code or settings instead of "
+                        "recomputing them; the tables mark them 'stale'")
+    parser.add_argument("--list-methods", action="store_true",
+                        help="list the built-in methods and those installed through the "
+                        "envelope_bench.methods entry point group, then exit")
+    parser.add_argument("--explain", nargs=2, metavar=("SCENE", "METHOD"),
+                        help="print the full provenance record of one scene's result(s) of one "
+                        "method, and whether the current code would reuse it; runs nothing")
+    parser.add_argument("--executor", default="local", choices=EXECUTORS,
+                        help="where missing runs execute: local (one after the other in this "
+                        "process, the default) or ray (one Ray task per building, method and "
+                        "views, on a Ray started here or on --ray-address; docs/cluster.md)")
+    parser.add_argument("--ray-address", metavar="ADDR",
+                        help="with --executor ray: a running cluster (HOST:PORT as printed by "
+                        "`ray start --head`, or auto); default: start Ray on this machine")
+    add_debug_flag(parser)
+    return parser.parse_args(argv)
