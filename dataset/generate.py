@@ -24,7 +24,7 @@ from tqdm import tqdm
 
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.import_config import add_import_arguments
-from dataset.ray_tasks import RayConfig
+from dataset.ray_tasks import RayConfig, add_executor_arguments
 from dataset.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
 from dataset.scene_writer import (
     GenerateConfig,
@@ -218,12 +218,7 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--workers", type=int, default=1,
                    help="processes: with --preset each renders one building at a time; with "
                         "--mesh they share the building's frames (default 1)")
-    p.add_argument("--executor", choices=("local", "ray"), default="local",
-                   help="with --preset: local (--workers processes here, the default) or ray "
-                        "(one Ray task per building; docs/cluster.md)")
-    p.add_argument("--ray-address", metavar="ADDR",
-                   help="with --executor ray: a running cluster (HOST:PORT printed by "
-                        "`ray start --head`, or auto); default: start Ray on this machine")
+    add_executor_arguments(p, "--workers processes here", "building, with --preset")
     p.add_argument("--seed", type=int, default=0, help="seed for cameras and looks (default 0)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")

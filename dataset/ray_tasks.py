@@ -16,13 +16,14 @@ early (Ctrl-C, an error in the caller) cancels every task not yet collected.
 
 from __future__ import annotations
 
+import argparse
 import logging
 import os
 import socket
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal, get_args
 
 WAIT_S = 0.5  # longest a wait for results blocks, so that Ctrl-C is seen promptly
 LOCAL_ONLY_ENV = "RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"  # read once, when ray is first imported
@@ -194,3 +195,18 @@ def _first_line(exc: BaseException) -> str:
     shown = cause if isinstance(cause, BaseException) else exc
     text = str(shown).strip().splitlines()
     return f"{type(shown).__name__}: {text[0] if text else ''}".strip()
+
+
+ExecutorName = Literal["local", "ray"]
+EXECUTORS: tuple[str, ...] = get_args(ExecutorName)
+
+
+def add_executor_arguments(parser: argparse.ArgumentParser, local_help: str, task: str) -> None:
+    """``--executor {local,ray}`` and ``--ray-address`` on a command line: ``local_help`` says
+    what ``local`` does there, ``task`` what one Ray task is."""
+    parser.add_argument("--executor", choices=EXECUTORS, default="local",
+                        help=f"local ({local_help}, the default) or ray (one Ray task per "
+                        f"{task}, on a Ray started here or on --ray-address; docs/cluster.md)")
+    parser.add_argument("--ray-address", metavar="ADDR",
+                        help="with --executor ray: a running cluster (HOST:PORT as printed by "
+                        "`ray start --head`, or auto); default: start Ray on this machine")

@@ -9,8 +9,8 @@ from pathlib import Path
 from dataset.cli_errors import add_debug_flag
 from dataset.degrade.spec import DEGRADATIONS
 from dataset.protocols import VIEW_PROTOCOLS
+from dataset.ray_tasks import add_executor_arguments
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
-from metrics.executors import EXECUTORS
 from metrics.methods import METHODS, Neural3dBudget
 
 
@@ -83,12 +83,7 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--explain", nargs=2, metavar=("SCENE", "METHOD"),
                         help="print the full provenance record of one scene's result(s) of one "
                         "method, and whether the current code would reuse it; runs nothing")
-    parser.add_argument("--executor", default="local", choices=EXECUTORS,
-                        help="where missing runs execute: local (one after the other in this "
-                        "process, the default) or ray (one Ray task per building, method and "
-                        "views, on a Ray started here or on --ray-address; docs/cluster.md)")
-    parser.add_argument("--ray-address", metavar="ADDR",
-                        help="with --executor ray: a running cluster (HOST:PORT as printed by "
-                        "`ray start --head`, or auto); default: start Ray on this machine")
+    add_executor_arguments(parser, "missing runs one after the other in this process",
+                           "building, method and views")
     add_debug_flag(parser)
     return parser.parse_args(argv)

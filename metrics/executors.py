@@ -20,15 +20,18 @@ from collections.abc import Iterator, Sequence
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Literal
 
 from dataset.atomic import atomic_directory
 from dataset.folder_pack import pack_folder, unpack_folder
-from dataset.ray_tasks import RayConfig, TaskLost, ray_session, run_tasks
+from dataset.ray_tasks import (
+    EXECUTORS,
+    ExecutorName,
+    RayConfig,
+    TaskLost,
+    ray_session,
+    run_tasks,
+)
 from metrics.runner import Execute, Job, Outcome, RunOne, execute_local
-
-ExecutorName = Literal["local", "ray"]
-EXECUTORS: tuple[str, ...] = ("local", "ray")
 
 
 def make_executor(name: ExecutorName, ray: RayConfig | None = None) -> Execute:
