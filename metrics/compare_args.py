@@ -22,7 +22,8 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
             "Compare WWR / window / facade-area and footprint estimates of 2D-S, 2D-SS and "
             "neural3d against ground truth, running only the results that are missing. "
             "Without --data it runs the built-in default: the tiny benchmark (generated into "
-            f"{DEFAULT_CACHE}), all methods, about 12 minutes on 2 CPU cores. Prints Table 2 "
+            f"{DEFAULT_CACHE}), all methods, about {DefaultBenchmark.expected_minutes:g} "
+            "minutes on 2 CPU cores. Prints Table 2 "
             "(errors per family) and Table 3 (footprint IoU) and writes them as CSV, Markdown "
             "and LaTeX with plots and provenance.json into --out."
         ),

@@ -61,5 +61,5 @@ def test_default_benchmark_announces_what_it_does(tmp_path):
     line = default.announce(("2D-S", "neural3d"), 1000)
     assert f"to be generated in {tmp_path / 'tiny'}" in line
     assert "neural3d 1000 training steps per building" in line
-    assert "about 12 minutes on 2 CPU cores" in line
+    assert f"about {default.expected_minutes:g} minutes on 2 CPU cores" in line
     assert "neural3d" not in default.announce(("2D-S",), 1000).split("methods")[1]
