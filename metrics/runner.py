@@ -48,6 +48,11 @@ class MethodSpec:
     where ``run`` writes a folder per scene (named by the scene) that the
     comparison keeps (neural3d's run folder); such a ``run`` also takes an
     ``artefacts_dir=`` keyword to write it elsewhere (a worker on another machine).
+    ``mesh_file``: a semantic mesh inside a scene's artefacts folder, for the
+    figures and the report; ``heavy``: run only at the highest severity of a
+    robustness study (unless asked otherwise); ``debug_images(scene folder,
+    protocol, folder)``: write its pipeline images. All of these come from the
+    method's :class:`dataset.method.Method` (``metrics.methods``).
     ``code`` names the modules or packages whose source the results depend on and
     ``libraries`` the distributions whose versions they depend on: both go into
     each result's provenance record, so changing them recomputes the results.
@@ -62,6 +67,9 @@ class MethodSpec:
     artefacts_dir: Path | None = None
     code: tuple[str, ...] = ("dataset",)
     libraries: tuple[str, ...] = ("numpy",)
+    mesh_file: str | None = None
+    heavy: bool = False
+    debug_images: Callable[[Path, str, Path], None] | None = None
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ from dataset.device import resolve_device
 from dataset.footprint import polygon_to_geojson
 from dataset.resources import check_mesh_resources
 from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
+from dataset.semantic_ply import write_semantic_ply
 from dataset.wwr import wwr_from_areas
 from neural3d.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
 from neural3d.footprint import footprint_from_sdf
@@ -45,7 +46,6 @@ from neural3d.meshing import (
     color_vertices,
     extract_mesh,
     label_vertices,
-    write_semantic_ply,
 )
 from neural3d.plane_sampling import plane_extents, plane_sampled_areas
 

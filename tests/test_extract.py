@@ -15,10 +15,10 @@ import neural3d.trained
 from dataset.classes import CLASS_NAMES
 from dataset.footprint import geojson_to_polygon
 from dataset.results import read_result, result_filename
+from dataset.semantic_ply import read_semantic_ply
 from dataset.truth import FacadeTruth
 from metrics.errors import facade_errors
 from neural3d.extract import ExtractConfig, extract_run, main, measure_field
-from neural3d.meshing import read_semantic_ply
 
 BOX_LO, BOX_HI = [-3.0, -2.0, 0.0], [3.0, 2.0, 10.0]  # window band 3-6 m: WWR 0.3
 

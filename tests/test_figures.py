@@ -13,10 +13,10 @@ from dataset.camera import Intrinsics, look_at
 from dataset.images import write_depth_m, write_labels, write_normals, write_rgb
 from dataset.mesh import LabelledMesh, write_labelled_ply
 from dataset.scene import Frame, Scene, write_transforms
+from dataset.semantic_ply import write_semantic_ply
 from figures.make import main
 from figures.meshes import face_labels_from_vertices, render_mesh_views
 from metrics.compare import main as compare_main
-from neural3d.meshing import write_semantic_ply
 
 ALL_FIGURES = ("table1_dataset", "dataset_renders", "2dss_pipeline", "neural3d_meshes",
                "footprint_overlays", "errors_by_family", "wwr_scatter", "iou_per_building")
@@ -113,7 +113,7 @@ def test_missing_inputs_are_skipped_with_a_message(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "skipped dataset_renders: no scene with images" in err
     assert "skipped 2dss_pipeline: no 2D-SS debug images" in err
-    assert "skipped neural3d_meshes: no neural3d mesh yet" in err
+    assert "skipped neural3d_meshes: no reconstructed mesh yet" in err
     assert "skipped footprint_overlays: no estimated footprint" in err
     assert "skipped iou_per_building: no footprint IoU to plot" in err
     assert (tmp_path / "f" / "errors_by_family.png").is_file()

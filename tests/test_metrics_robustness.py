@@ -50,7 +50,7 @@ def test_study_rejects_bad_levels() -> None:
     with pytest.raises(ValueError):
         RobustnessStudy(levels=(("mask_miss", (2.0,)),))
     with pytest.raises(ValueError):
-        RobustnessStudy(neural3d_levels="some")
+        RobustnessStudy(heavy_levels="some")
 
 
 def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
