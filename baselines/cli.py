@@ -15,8 +15,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from baselines.views import PROTOCOLS
 from dataset.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
+from dataset.protocols import VIEW_PROTOCOLS
 from dataset.results import MethodResult, write_result
 from dataset.scene import Scene, read_scene
 from dataset.warnings_summary import summarise_warnings
@@ -53,7 +53,7 @@ def default_results_folder(data: Path) -> Path:
 
 def add_common_arguments(parser: argparse.ArgumentParser) -> None:
     """--views, --data, --out, --debug-images and --debug."""
-    parser.add_argument("--views", required=True, choices=PROTOCOLS,
+    parser.add_argument("--views", required=True, choices=VIEW_PROTOCOLS,
                         help="view protocol: 'ideal' (one perpendicular view per facade) or "
                              "'multi' (several natural views per facade)")
     parser.add_argument("--data", required=True, type=Path,

@@ -56,12 +56,12 @@ from baselines.rectify import (
     rectified_wwr,
     rectify_labels,
 )
-from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
+from baselines.views import FacadeView, Protocol, ViewError, load_views
 from dataset.cli_errors import check_output_folder
 from dataset.device import resolve_device
 from dataset.images import read_rgb
 from dataset.results import FacadeEstimate, MethodResult
-from dataset.scene import Scene
+from dataset.scene import Scene, scene_name
 
 METHOD = "2D-SS"
 

@@ -15,6 +15,7 @@ from shapely.geometry import Polygon
 
 from dataset.facade_geometry import WallSpec, wall_faces
 from dataset.footprint import polygon_to_geojson
+from dataset.mesh import MERGE_DECIMALS
 from dataset.polygon_mesh import PlanarFace, triangulate_faces
 from dataset.truth import Building, BuildingTruth, BuildingType, FacadeTruth
 from dataset.wwr import gross_facade_area_m2, wwr_from_areas
@@ -82,7 +83,7 @@ def facade_outlines_m(walls: list[WallSpec]) -> dict[str, list[list[list[float]]
     """
     out: dict[str, list[list[list[float]]]] = {}
     for w in walls:
-        corners = np.round(w.frame.points_m(w.outline_uv), 9) + 0.0
+        corners = np.round(w.frame.points_m(w.outline_uv), MERGE_DECIMALS) + 0.0
         out.setdefault(str(w.facade_id), []).append(corners.tolist())
     return out
 

@@ -24,6 +24,8 @@ CLASS_RGB: tuple[tuple[int, int, int], ...] = (
 )
 """Display colour (RGB, 0-255) of each class id, in id order: the one palette of figures,
 debug images and the HTML report."""
+UNKNOWN_CLASS_RGB = (255, 0, 255)
+"""Display colour of an id beyond the known classes: it stands out."""
 CLASS_NAMES: tuple[str, ...] = tuple(c.name.lower() for c in SemanticClass)
 FACADE_CLASSES: tuple[SemanticClass, ...] = (
     SemanticClass.WALL,

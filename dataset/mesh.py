@@ -15,6 +15,10 @@ import numpy as np
 from dataset.atomic import write_bytes_atomic
 from dataset.classes import FACADE_CLASSES, NO_FACADE, NUM_CLASSES
 
+MERGE_DECIMALS = 9
+"""Coordinates (m) equal to this many decimals are the same point (~1 nm; exporters print 6-17
+digits): merged vertices, canonical outline corners."""
+
 
 @dataclass(frozen=True)
 class LabelledMesh:

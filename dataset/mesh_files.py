@@ -16,11 +16,10 @@ from typing import Literal
 import numpy as np
 
 from dataset.classes import CLASS_NAMES, NO_FACADE, SemanticClass
-from dataset.mesh import LabelledMesh, read_labelled_ply
+from dataset.mesh import MERGE_DECIMALS, LabelledMesh, read_labelled_ply
 from dataset.mesh_validation import check_mesh_coordinates
 
 UpAxis = Literal["z", "y"]
-MERGE_DECIMALS = 9  # vertices closer than ~1 nm are the same vertex (exporters print 6-17 digits)
 
 CLASS_SYNONYMS: dict[str, SemanticClass] = {
     "walls": SemanticClass.WALL,

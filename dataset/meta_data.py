@@ -36,7 +36,8 @@ from dataset.labels import (  # noqa: F401  (re-exported: the mappings lived her
     read_remapped_labels,
     remap_labels,
 )
-from dataset.scene import DEFAULT_DEPTH_UNIT_M, SPLITS, Frame, Scene
+from dataset.protocols import SPLITS
+from dataset.scene import DEFAULT_DEPTH_UNIT_M, Frame, Scene
 from dataset.scene_validation import validate_scene
 
 PoseConvention = Literal["opencv", "opengl"]

@@ -18,9 +18,8 @@ import shapely
 from shapely.geometry import Polygon
 
 from dataset.classes import NO_FACADE, NUM_CLASSES
-from dataset.mesh import LabelledMesh
+from dataset.mesh import MERGE_DECIMALS, LabelledMesh
 
-MERGE_DECIMALS = 9
 COLLINEAR_TOL_M = 1e-7
 """A vertex closer than this to a triangle edge lies on it (earcut leaves such T-junctions and
 zero-area triangles where openings line up, e.g. sills at one height)."""

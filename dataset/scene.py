@@ -9,18 +9,17 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from dataset.atomic import write_json_atomic
 from dataset.camera import Intrinsics
 from dataset.classes import CLASS_NAMES
+from dataset.protocols import SPLITS, TRAIN_PROTOCOL, Split
 from dataset.scene_validation import validate_scene
 from dataset.truth import BuildingTruth, read_building
 
-Split = Literal["train", "eval", "ideal", "multi"]  # eval + the protocols (dataset.protocols)
-SPLITS: tuple[str, ...] = ("train", "eval", "ideal", "multi")
 DEFAULT_DEPTH_UNIT_M = 0.001  # 16-bit depth PNG in millimetres: up to 65.5 m
 
 
@@ -62,6 +61,12 @@ class Scene:
     def path(self, relative: str) -> Path:
         """Absolute path of a file named relative to the scene folder."""
         return self.root / relative
+
+
+def scene_name(scene: Scene | str | Path) -> str:
+    """A scene's name in result files, run folders and warnings: its folder's name."""
+    root = scene.root if isinstance(scene, Scene) else Path(scene)
+    return root.resolve().name
 
 
 def read_scene(root: str | Path, *, validate: bool = True) -> Scene:
@@ -166,7 +171,7 @@ def _frame_from_json(fr: dict[str, Any], meta: dict[str, Any]) -> Frame:
     pose = np.asarray(fr["transform_matrix"], dtype=np.float64)
     if pose.shape != (4, 4):
         raise ValueError(f"frame {fr.get('file_path')}: transform_matrix must be 4x4")
-    split = fr.get("split", "train")
+    split = fr.get("split", TRAIN_PROTOCOL)
     if split not in SPLITS:
         raise ValueError(f"frame {fr.get('file_path')}: unknown split {split!r}")
     return Frame(

@@ -38,6 +38,7 @@ from dataset.images import (
     write_rgb,
 )
 from dataset.mesh import write_labelled_ply
+from dataset.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL, Split
 from dataset.provenance import (
     Provenance,
     ProvenanceChange,
@@ -46,7 +47,7 @@ from dataset.provenance import (
     provenance_changes,
 )
 from dataset.render import Raycaster, render_view
-from dataset.scene import Frame, Scene, Split, write_transforms
+from dataset.scene import Frame, Scene, write_transforms
 from dataset.shading import RgbConfig
 from dataset.truth import Building, write_building
 from dataset.worker_pool import worker_pool
@@ -121,16 +122,16 @@ def plan_views(
     views = []
     for i, pose in enumerate(orbit):
         # Interleave so train and eval both cover the whole sphere band.
-        split: Split = "train" if np.floor((i + 1) * f) > np.floor(i * f) else "eval"
+        split = TRAIN_PROTOCOL if np.floor((i + 1) * f) > np.floor(i * f) else EVAL_SPLIT
         views.append(PlannedView(split, f"{split}_{i:04d}", pose))
     if config.ideal:
         for i, (fid, pose) in enumerate(ideal_views(building, raycaster, k,
                                                     config=config.facade_views)):
-            views.append(PlannedView("ideal", f"ideal_{i:04d}", pose, fid))
+            views.append(PlannedView(IDEAL_PROTOCOL, f"{IDEAL_PROTOCOL}_{i:04d}", pose, fid))
     if config.multi:
         for i, (fid, pose) in enumerate(multi_views(building, raycaster, k,
                                                     config=config.facade_views, seed=seed + 1)):
-            views.append(PlannedView("multi", f"multi_{i:04d}", pose, fid))
+            views.append(PlannedView(MULTI_PROTOCOL, f"{MULTI_PROTOCOL}_{i:04d}", pose, fid))
     return views
 
 

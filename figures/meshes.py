@@ -21,7 +21,7 @@ from dataset.classes import NO_FACADE
 from dataset.mesh import LabelledMesh, read_labelled_ply
 from dataset.render import Raycaster, render_ground_truth
 from dataset.semantic_ply import read_semantic_ply
-from figures.style import CLASS_RGB, MissingInput
+from figures.style import CLASS_RGB_ARRAY, MissingInput
 from metrics.mesh_pointers import read_mesh_pointers
 from metrics.plots import save_figure
 
@@ -69,7 +69,7 @@ def render_mesh_views(
         light /= np.linalg.norm(light)
         lambert = np.clip(gt.normals_world @ light, 0, 1)
         shade = config.ambient + (1 - config.ambient) * lambert
-        rgb = CLASS_RGB[np.minimum(gt.labels, len(CLASS_RGB) - 1)] * shade[..., None]
+        rgb = CLASS_RGB_ARRAY[np.minimum(gt.labels, len(CLASS_RGB_ARRAY) - 1)] * shade[..., None]
         rgb[gt.depth_z_m <= 0] = 255
         images.append(np.clip(rgb, 0, 255).astype(np.uint8))
     return images

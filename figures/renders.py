@@ -9,6 +9,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from dataset.images import read_depth_m, read_labels, read_normals, read_rgb
+from dataset.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
 from dataset.scene import Frame, Scene, read_scene
 from dataset.truth import BuildingTruth
 from figures.style import MissingInput, colour_depth, colour_labels, colour_normals
@@ -16,7 +17,8 @@ from metrics.aggregate import family_rank
 from metrics.plots import save_figure
 
 MODALITIES = ("colour", "semantics", "normals", "depth")
-PREFERRED_SPLITS = ("eval", "train", "multi", "ideal")  # an orbit view shows the whole building
+# an orbit view shows the whole building
+PREFERRED_SPLITS = (EVAL_SPLIT, TRAIN_PROTOCOL, MULTI_PROTOCOL, IDEAL_PROTOCOL)
 
 
 def example_views(

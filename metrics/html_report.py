@@ -17,6 +17,7 @@ from pathlib import Path
 
 from dataset.atomic import write_text_atomic
 from dataset.footprint import geojson_to_polygon
+from dataset.protocols import IDEAL_PROTOCOL
 from dataset.semantic_ply import read_semantic_ply
 from metrics.aggregate import Summary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
@@ -232,7 +233,7 @@ def _images(scene: str, scene_dir: Path, out_dir: Path) -> list[str]:
     transforms = scene_dir / "transforms.json"
     if transforms.is_file():
         frames = json.loads(transforms.read_text()).get("frames", [])
-        ideal = [f for f in frames if f.get("split") == "ideal"] or frames[:1]
+        ideal = [f for f in frames if f.get("split") == IDEAL_PROTOCOL] or frames[:1]
         if ideal and (scene_dir / ideal[0]["file_path"]).is_file():
             out.append(image_tag(scene_dir / ideal[0]["file_path"], "render (first ideal view)"))
     for png in sorted((out_dir / "2dss_pipeline").glob(f"{scene}__*.png")):

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
 
-from dataset.classes import CLASS_NAMES, CLASS_RGB
+from dataset.classes import CLASS_NAMES, CLASS_RGB, UNKNOWN_CLASS_RGB
 
 SVG_SIZE_PX = 320
 SVG_MARGIN_PX = 10
@@ -115,7 +115,7 @@ def mesh_figure_json(vertices_m: np.ndarray, faces: np.ndarray, vertex_labels: n
     """
     import plotly.graph_objects as go
 
-    palette = np.array([*CLASS_RGB, (255, 0, 255)])
+    palette = np.array([*CLASS_RGB, UNKNOWN_CLASS_RGB])
     labels = np.minimum(np.asarray(vertex_labels, dtype=int), len(CLASS_RGB))
     colours = [f"rgb({r},{g},{b})" for r, g, b in palette[labels]]
     v = np.round(np.asarray(vertices_m, dtype=float), 3)

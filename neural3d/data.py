@@ -7,7 +7,6 @@ Only what training may use is read: RGB, semantic masks, intrinsics, poses
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import cv2
 import numpy as np
@@ -17,7 +16,8 @@ from torch import Tensor
 from dataset.camera import Intrinsics, rays_world
 from dataset.classes import SemanticClass
 from dataset.images import read_rgb
-from dataset.scene import Scene, Split
+from dataset.protocols import Split
+from dataset.scene import Scene
 from dataset.scene_validation import read_frame_depth_m, read_frame_labels
 from neural3d.normalisation import Normalisation
 from neural3d.scene_box import visual_hull_box_m
@@ -145,6 +145,3 @@ def frames_to_pixels(frames: list[LoadedFrame], norm: Normalisation,
     )
 
 
-def scene_name(scene_dir: Path) -> str:
-    """The scene's name: its folder's name."""
-    return Path(scene_dir).resolve().name

@@ -31,6 +31,7 @@ from dataset.classes import NUM_CLASSES, class_id_from_name
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.device import resolve_device
 from dataset.footprint import polygon_to_geojson
+from dataset.protocols import TRAIN_PROTOCOL
 from dataset.resources import check_mesh_resources
 from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
 from dataset.semantic_ply import write_semantic_ply
@@ -50,7 +51,7 @@ from neural3d.meshing import (
 from neural3d.plane_sampling import plane_extents, plane_sampled_areas
 
 METHOD = "neural3d"
-PROTOCOL = "train"
+PROTOCOL = TRAIN_PROTOCOL
 
 
 def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:

@@ -12,6 +12,7 @@ from typing import Literal
 
 import numpy as np
 
+from neural3d.chunks import DEFAULT_CHUNK_POINTS
 from neural3d.measure import MeasureConfig
 
 
@@ -32,7 +33,7 @@ class ExtractConfig:
     """
 
     resolution: int = 256
-    chunk_points: int = 1 << 16
+    chunk_points: int = DEFAULT_CHUNK_POINTS
     min_component_area_fraction: float = 0.01  # floaters of a neural SDF
     # one slice: L-shape IoU 0.82 at 0.2 m, 0.93 at 0.5 m, 0.97 at 1 m; averaging 1-4 m: +0.01
     footprint_heights_m: tuple[float, ...] = (1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0)

@@ -21,7 +21,8 @@ import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
 from tqdm import tqdm
 
-from neural3d.meshing import DEFAULT_CHUNK_POINTS, SdfFn, check_box, evaluate_in_chunks
+from neural3d.chunks import DEFAULT_CHUNK_POINTS, evaluate_in_chunks
+from neural3d.meshing import SdfFn, check_box
 
 MAX_FOOTPRINT_CELLS = 4096  # per axis: 16.8 M samples
 

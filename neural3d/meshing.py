@@ -23,12 +23,12 @@ from tqdm import tqdm
 from dataset.classes import NUM_CLASSES
 from dataset.mesh import triangle_areas_m2
 from dataset.semantic_ply import check_mesh_arrays, check_points_m
+from neural3d.chunks import DEFAULT_CHUNK_POINTS, evaluate_in_chunks
 
 SdfFn = Callable[[np.ndarray], np.ndarray]
 LabelFn = Callable[[np.ndarray], np.ndarray]
 ColorFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
-DEFAULT_CHUNK_POINTS = 1 << 18  # 262k points: ~3 MB of float32 coordinates per call
 MAX_GRID_SAMPLES = 1025  # per axis; 1025³ float32 is 4.3 GB, the most we allow in memory
 
 
@@ -279,28 +279,6 @@ def _slab_points(xs: np.ndarray, plane_yz: np.ndarray) -> np.ndarray:
     pts[:, :, 0] = xs[:, None]
     pts[:, :, 1:] = plane_yz[None]
     return pts.reshape(-1, 3)
-
-
-def evaluate_in_chunks(
-    fn: Callable[[np.ndarray], np.ndarray],
-    points: np.ndarray,
-    chunk_points: int,
-    out_shape: tuple[int, ...] = (),
-) -> np.ndarray:
-    """``fn`` on ``points`` (N, D), at most ``chunk_points`` rows per call; (N, *out_shape)."""
-    if chunk_points < 1:
-        raise ValueError(f"chunk_points must be >= 1, got {chunk_points}")
-    parts = []
-    for start in range(0, len(points), chunk_points):
-        chunk = points[start:start + chunk_points]
-        out = np.asarray(fn(chunk))
-        if out.shape != (len(chunk), *out_shape):
-            raise ValueError(f"the callable returned shape {out.shape} for {len(chunk)} points; "
-                             f"expected {(len(chunk), *out_shape)}")
-        parts.append(out)
-    if not parts:
-        return np.zeros((0, *out_shape))
-    return np.concatenate(parts)
 
 
 def check_box(box_min_m, box_max_m) -> tuple[np.ndarray, np.ndarray]:

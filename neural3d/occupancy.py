@@ -19,7 +19,7 @@ import torch
 import torch.nn.functional as F
 from torch import Tensor
 
-_REFRESH_CHUNK = 1 << 16  # cell centres per SDF call
+from neural3d.chunks import DEFAULT_CHUNK_POINTS
 
 
 class OccupancyGrid:
@@ -55,7 +55,7 @@ class OccupancyGrid:
         ``sdf_fn``: "(N, 3)" -> "(N,)" in normalised units; ``margin`` in the same units.
         """
         centres = self.cell_centres()
-        sdf = torch.cat([sdf_fn(c) for c in centres.split(_REFRESH_CHUNK)])
+        sdf = torch.cat([sdf_fn(c) for c in centres.split(DEFAULT_CHUNK_POINTS)])
         near_surface = (sdf.abs() < 0.5 * math.sqrt(3) * self.cell + margin).reshape(self.shape)
         grown = F.max_pool3d(near_surface[None, None].float(), 3, stride=1, padding=1)
         self.occupied = grown[0, 0] > 0

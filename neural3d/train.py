@@ -31,9 +31,10 @@ from dataset.atomic import write_json_atomic, write_text_atomic
 from dataset.classes import CLASS_NAMES
 from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.device import resolve_device
+from dataset.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from dataset.resources import check_training_resources
 from dataset.results import code_version
-from dataset.scene import read_scene
+from dataset.scene import read_scene, scene_name
 from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
 from neural3d.config import PRESETS, TrainConfig, config_from_dict, config_to_dict, preset_config
 from neural3d.data import (
@@ -41,7 +42,6 @@ from neural3d.data import (
     background_class,
     frames_to_pixels,
     load_frames,
-    scene_name,
     scene_normalisation,
 )
 from neural3d.evaluate import eval_pixel_subset, evaluate
@@ -159,8 +159,8 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     check_training_resources(sum(
         round(f.intrinsics.width * config.image_scale) * round(f.intrinsics.height
                                                                * config.image_scale)
-        for f in scene.frames_in("train")))
-    frames = load_frames(scene, "train", image_scale=config.image_scale,
+        for f in scene.frames_in(TRAIN_PROTOCOL)))
+    frames = load_frames(scene, TRAIN_PROTOCOL, image_scale=config.image_scale,
                          with_depth=config.depth_loss)
     if resume:
         norm = _check_resumable(run_dir, config)
@@ -170,9 +170,9 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
                           len(frames))
     pixels = frames_to_pixels(frames, norm, device)
     eval_pixels = None
-    eval_frames = scene.frames_in("eval")
+    eval_frames = scene.frames_in(EVAL_SPLIT)
     if eval_frames:
-        chosen = load_frames(scene, "eval", image_scale=config.image_scale)
+        chosen = load_frames(scene, EVAL_SPLIT, image_scale=config.image_scale)
         pick = torch.linspace(0, len(chosen) - 1, min(config.eval_max_frames, len(chosen)))
         eval_pixels = eval_pixel_subset(
             frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device),

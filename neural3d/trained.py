@@ -10,12 +10,12 @@ import torch
 from torch import Tensor
 
 from dataset.device import resolve_device
+from dataset.scene import scene_name
 from neural3d.checkpoint import read_checkpoint
+from neural3d.chunks import DEFAULT_CHUNK_POINTS
 from neural3d.config import FieldConfig, config_from_dict
 from neural3d.fields import SemanticSDF
 from neural3d.normalisation import Normalisation
-
-_CHUNK = 1 << 17  # points per forward pass: bounds memory for marching-cubes-sized queries
 
 
 class TrainedField:
@@ -30,7 +30,7 @@ class TrainedField:
         self.field = field
         self.normalisation = normalisation
         self.scene_dir = Path(scene_dir)
-        self.scene_name = self.scene_dir.name
+        self.scene_name = scene_name(self.scene_dir)
         self.class_names = tuple(class_names)
         self.box_min_m = np.asarray(normalisation.box_min_m, dtype=np.float64)
         self.box_max_m = np.asarray(normalisation.box_max_m, dtype=np.float64)
@@ -43,14 +43,15 @@ class TrainedField:
         """"(N, 3)" world points (m) -> "(N,)" signed distance in metres, positive outside."""
         x = self._unit(points_world_m)
         with torch.no_grad():
-            out = [self.field.sdf(c) for c in x.split(_CHUNK)]
+            out = [self.field.sdf(c) for c in x.split(DEFAULT_CHUNK_POINTS)]
         return _cat(out, x) * self.normalisation.scale_m
 
     def semantic_logits(self, points_world_m: Tensor) -> Tensor:
         """"(N, 3)" world points (m) -> "(N, C)" class logits (view-independent)."""
         x = self._unit(points_world_m)
         with torch.no_grad():
-            out = [self.field.semantic_logits(self.field.sdf_net(c)[1]) for c in x.split(_CHUNK)]
+            out = [self.field.semantic_logits(self.field.sdf_net(c)[1])
+                   for c in x.split(DEFAULT_CHUNK_POINTS)]
         return _cat(out, x, self.field.num_classes)
 
     def rgb(self, points_world_m: Tensor, view_dirs_world: Tensor) -> Tensor:
@@ -62,7 +63,7 @@ class TrainedField:
                              f"{tuple(d.shape)}")
         d = d / d.norm(dim=-1, keepdim=True).clamp(min=1e-12)
         out = []
-        for xc, dc in zip(x.split(_CHUNK), d.split(_CHUNK)):
+        for xc, dc in zip(x.split(DEFAULT_CHUNK_POINTS), d.split(DEFAULT_CHUNK_POINTS)):
             _, feature, grad = self.field.sdf_feature_gradient(xc, create_graph=False)
             with torch.no_grad():
                 out.append(self.field.colour(xc, dc, grad, feature))

@@ -167,11 +167,11 @@ def test_table1_ranges_per_family(tmp_path):
 
 
 def test_display_encodings():
-    from figures.style import CLASS_RGB, colour_depth, colour_labels, colour_normals
+    from figures.style import CLASS_RGB_ARRAY, colour_depth, colour_labels, colour_normals
 
     labels = np.array([[0, 2], [5, 200]], np.uint8)
     rgb = colour_labels(labels)
-    assert rgb[0, 1].tolist() == CLASS_RGB[2].tolist() and rgb[1, 1].tolist() == [255, 0, 255]
+    assert rgb[0, 1].tolist() == CLASS_RGB_ARRAY[2].tolist() and rgb[1, 1].tolist() == [255, 0, 255]
     normals = np.array([[[0, 0, 0], [1, 0, 0]]], np.float32)
     assert colour_normals(normals).tolist() == [[[0, 0, 0], [255, 128, 128]]]
     depth = colour_depth(np.array([[0.0, 5.0, 10.0]]))
