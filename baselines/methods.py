@@ -1,4 +1,4 @@
-"""2D-S and 2D-SS as benchmark methods (:class:`dataset.method.Method`)."""
+"""2D-S and 2D-SS as benchmark methods (:class:`dataset.core.method.Method`)."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ from pathlib import Path
 
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
-from dataset.method import Method
-from dataset.protocols import VIEW_PROTOCOLS
-from dataset.scene import Scene
+from dataset.core.method import Method
+from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.scene_record import Scene
 
 LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")
 

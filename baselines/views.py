@@ -13,12 +13,12 @@ from typing import Literal
 
 import numpy as np
 
-from dataset.camera import Intrinsics
-from dataset.protocols import VIEW_PROTOCOLS, ViewProtocol
-from dataset.scene import Frame, Scene, scene_name
-from dataset.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
+from dataset.core.camera import Intrinsics
+from dataset.core.protocols import VIEW_PROTOCOLS, ViewProtocol
+from dataset.core.scene_record import Frame, Scene, scene_name
+from dataset.scenes.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
 
-Protocol = ViewProtocol  # the 2D methods' protocols (dataset.protocols)
+Protocol = ViewProtocol  # the 2D methods' protocols (dataset.core.protocols)
 
 
 class ViewError(ValueError):

@@ -40,10 +40,10 @@ from pathlib import Path
 
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
-from dataset.atomic import write_text_atomic  # noqa: E402
+from dataset.core.atomic import write_text_atomic  # noqa: E402
+from dataset.core.results import MethodResult  # noqa: E402
+from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
 from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
-from dataset.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
-from dataset.results import MethodResult  # noqa: E402
 from metrics.benchmark_cache import DefaultBenchmark  # noqa: E402
 from metrics.compare import compare  # noqa: E402
 from metrics.executors import make_executor  # noqa: E402

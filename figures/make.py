@@ -14,9 +14,9 @@ from collections.abc import Callable, Sequence
 from datetime import datetime, timezone
 from pathlib import Path
 
-from dataset.atomic import write_json_atomic
-from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
-from dataset.results import code_version
+from dataset.core.atomic import write_json_atomic
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.results import code_version
 from figures.dataset_table import read_truths, table1_dataset
 from figures.footprints import footprint_pairs, plot_footprint_overlays
 from figures.meshes import plot_reconstructed_meshes, reconstructed_meshes

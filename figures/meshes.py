@@ -3,7 +3,7 @@
 Reads the ``<method>_runs.json`` files that ``metrics.compare`` writes for
 methods that keep a mesh (neural3d; :mod:`metrics.mesh_pointers`) and, when
 the scene is there, the scene's true ``mesh.ply``.
-Rendering is exact ray casting (:mod:`dataset.render`) with class colours and
+Rendering is exact ray casting (:mod:`dataset.rendering.render`) with class colours and
 simple Lambert shading.
 """
 
@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.camera import Intrinsics, look_at
-from dataset.classes import NO_FACADE
-from dataset.mesh import LabelledMesh, read_labelled_ply
-from dataset.render import Raycaster, render_ground_truth
-from dataset.semantic_ply import read_semantic_ply
+from dataset.core.camera import Intrinsics, look_at
+from dataset.core.classes import NO_FACADE
+from dataset.core.mesh import LabelledMesh, read_labelled_ply
+from dataset.core.semantic_ply import read_semantic_ply
+from dataset.rendering.render import Raycaster, render_ground_truth
 from figures.style import CLASS_RGB_ARRAY, MissingInput
 from metrics.mesh_pointers import read_mesh_pointers
 from metrics.plots import save_figure

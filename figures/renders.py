@@ -8,10 +8,11 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.images import read_depth_m, read_labels, read_normals, read_rgb
-from dataset.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
-from dataset.scene import Frame, Scene, read_scene
-from dataset.truth import BuildingTruth
+from dataset.core.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
+from dataset.core.scene_record import Frame, Scene
+from dataset.core.truth import BuildingTruth
+from dataset.scenes.images import read_depth_m, read_labels, read_normals, read_rgb
+from dataset.scenes.scene import read_scene
 from figures.style import MissingInput, colour_depth, colour_labels, colour_normals
 from metrics.aggregate import family_rank
 from metrics.plots import save_figure

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.protocols import PROTOCOLS
-from dataset.truth import BUILDING_TYPES
+from dataset.core.protocols import PROTOCOLS
+from dataset.core.truth import BUILDING_TYPES
 from metrics.errors import BuildingErrors
 from metrics.methods import METHODS
 

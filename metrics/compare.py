@@ -22,13 +22,13 @@ from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
 
-from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
-from dataset.cli_errors import check_output_folder, run_cli
+from dataset.core.atomic import atomic_directory, write_json_atomic, write_text_atomic
+from dataset.core.cli_errors import check_output_folder, run_cli
+from dataset.core.device import resolve_device
+from dataset.core.results import code_version
+from dataset.core.truth import BuildingTruth, read_building
 from dataset.degrade.spec import parse_specs
-from dataset.device import resolve_device
-from dataset.ray_tasks import RayConfig
-from dataset.results import code_version
-from dataset.truth import BuildingTruth, read_building
+from dataset.executors.ray_tasks import RayConfig
 from metrics.aggregate import aggregate_by_family
 from metrics.benchmark_cache import DefaultBenchmark, ensure_benchmark
 from metrics.compare_args import neural3d_config, parse_compare_args, study_config

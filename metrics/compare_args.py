@@ -8,10 +8,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from dataset.cli_errors import add_debug_flag
+from dataset.core.cli_errors import add_debug_flag
+from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.degrade.spec import DEGRADATIONS
-from dataset.protocols import VIEW_PROTOCOLS
-from dataset.ray_tasks import add_executor_arguments
+from dataset.executors.ray_tasks import add_executor_arguments
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
 from metrics.methods import METHODS
 from neural3d.method import Neural3dBudget

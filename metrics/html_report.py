@@ -15,10 +15,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from dataset.atomic import write_text_atomic
-from dataset.footprint import geojson_to_polygon
-from dataset.protocols import IDEAL_PROTOCOL
-from dataset.semantic_ply import read_semantic_ply
+from dataset.core.atomic import write_text_atomic
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.protocols import IDEAL_PROTOCOL
+from dataset.core.semantic_ply import read_semantic_ply
 from metrics.aggregate import Summary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
 from metrics.html_sections import (

@@ -1,9 +1,9 @@
 """``<method>_runs.json``: where the meshes of a method that keeps one (neural3d) are.
 
 :mod:`metrics.compare` writes one such file per method with a ``mesh_file``
-(:class:`dataset.method.Method`) into its output folder; the HTML report and
+(:class:`dataset.core.method.Method`) into its output folder; the HTML report and
 ``figures.make`` read them to draw each scene's semantic mesh
-(:mod:`dataset.semantic_ply`).
+(:mod:`dataset.core.semantic_ply`).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dataset.atomic import write_json_atomic
+from dataset.core.atomic import write_json_atomic
 from metrics.runner import MethodSpec
 
 SUFFIX = "_runs.json"

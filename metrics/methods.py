@@ -1,4 +1,4 @@
-"""The methods the comparison runs, all through :class:`dataset.method.Method`.
+"""The methods the comparison runs, all through :class:`dataset.core.method.Method`.
 
 The built-in ones (2D-S, 2D-SS in :mod:`baselines.methods`, neural3d in
 :mod:`neural3d.method`) are found by where they are declared; any other name is
@@ -17,11 +17,11 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from dataset.method import Method, installed_methods
-from dataset.protocols import VIEW_PROTOCOLS
-from dataset.ray_tasks import TaskResources
-from dataset.results import MethodResult
-from dataset.scene import read_scene
+from dataset.core.method import Method, installed_methods
+from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.results import MethodResult
+from dataset.executors.ray_tasks import TaskResources
+from dataset.scenes.scene import read_scene
 from metrics.runner import MethodSpec
 
 # name -> (module, attribute) of the built-in methods' declarations, in table order.

@@ -9,8 +9,8 @@ project; no footprint (Table 3) reference exists, as the 2D methods estimate non
 
 from __future__ import annotations
 
-from dataset.protocols import IDEAL_PROTOCOL as IDEAL
-from dataset.protocols import MULTI_PROTOCOL as MULTI
+from dataset.core.protocols import IDEAL_PROTOCOL as IDEAL
+from dataset.core.protocols import MULTI_PROTOCOL as MULTI
 from metrics.aggregate import Summary
 
 REFERENCE_LABEL = "paper preset (28 buildings, 512 px, commit 787c3dfe2b9d)"

@@ -15,12 +15,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dataset.atomic import write_text_atomic
+from dataset.core.atomic import write_text_atomic
 from dataset.degrade.spec import DegradeSpec
 from metrics.aggregate import method_rank, protocol_rank
 from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import BuildingErrors
-from metrics.robustness_plot import plot_robustness
+from metrics.robustness_plot import RobustnessRow, plot_robustness
 from metrics.runner import MethodSpec
 from metrics.tables import Table, to_csv, to_markdown
 
@@ -53,21 +53,6 @@ class RobustnessStudy:
         for name, severities in self.levels:
             for s in severities:
                 DegradeSpec(name, s, self.seed)  # type: ignore[arg-type]
-
-
-@dataclass(frozen=True)
-class RobustnessRow:
-    """Mean errors (APE, %) of one method and views under one degradation and severity."""
-
-    degradation: str
-    severity: float
-    method: str
-    protocol: str
-    buildings: int
-    failed: int
-    wwr_ape: float | None
-    window_ape: float | None
-    facade_ape: float | None
 
 
 def run_study(

@@ -1,4 +1,4 @@
-"""neural3d as a benchmark method (:class:`dataset.method.Method`): train, then extract.
+"""neural3d as a benchmark method (:class:`dataset.core.method.Method`): train, then extract.
 
 Its config, :class:`Neural3dBudget`, is the step budget and the few settings a
 comparison chooses; the training and extraction configs follow from it
@@ -12,12 +12,12 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
-from dataset.method import Method
-from dataset.protocols import TRAIN_PROTOCOL
-from dataset.results import MethodResult
-from dataset.scene import Scene
+from dataset.core.method import Method
+from dataset.core.protocols import TRAIN_PROTOCOL
+from dataset.core.results import MethodResult
+from dataset.core.scene_record import Scene
 from neural3d.config import TrainConfig, config_to_dict, preset_config
-from neural3d.extract_config import ExtractConfig
+from neural3d.extraction.extract_config import ExtractConfig
 
 RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
 EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
@@ -101,10 +101,9 @@ def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
     """
     import torch
 
-    from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint
-
     # isort sees a module as first-party only once its file exists: keep this block as is.
     from neural3d.extract import extract_run  # noqa: I001
+    from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
     from neural3d.train import train
 
     config = train_config(budget)

@@ -27,30 +27,31 @@ from pathlib import Path
 import torch
 from tqdm import tqdm
 
-from dataset.atomic import write_json_atomic, write_text_atomic
-from dataset.classes import CLASS_NAMES
-from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
-from dataset.device import resolve_device
-from dataset.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
-from dataset.resources import check_training_resources
-from dataset.results import code_version
-from dataset.scene import read_scene, scene_name
-from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
+from dataset.core.atomic import write_json_atomic, write_text_atomic
+from dataset.core.classes import CLASS_NAMES
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.device import resolve_device
+from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
+from dataset.core.resources import check_training_resources
+from dataset.core.results import code_version
+from dataset.core.scene_record import scene_name
+from dataset.scenes.scene import read_scene
 from neural3d.config import PRESETS, TrainConfig, config_from_dict, config_to_dict, preset_config
-from neural3d.data import (
+from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
+from neural3d.field.fields import SemanticSDF
+from neural3d.field.normalisation import Normalisation
+from neural3d.field.trained import TrainedField, build_field
+from neural3d.rendering.model import RenderOutput, render_rays
+from neural3d.rendering.occupancy import OccupancyGrid
+from neural3d.training.data import (
     Pixels,
     background_class,
     frames_to_pixels,
     load_frames,
     scene_normalisation,
 )
-from neural3d.evaluate import eval_pixel_subset, evaluate
-from neural3d.fields import SemanticSDF
-from neural3d.losses import psnr, total_loss
-from neural3d.model import RenderOutput, render_rays
-from neural3d.normalisation import Normalisation
-from neural3d.occupancy import OccupancyGrid
-from neural3d.trained import TrainedField, build_field
+from neural3d.training.evaluate import eval_pixel_subset, evaluate
+from neural3d.training.losses import psnr, total_loss
 
 LOG_EVERY = 10  # steps between log.csv rows
 LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "depth", "psnr",

@@ -23,13 +23,13 @@ import numpy as np
 import pytest
 from shapely.geometry import box as shapely_box
 
-from dataset.classes import NO_FACADE, SemanticClass
-from dataset.footprint import polygon_to_geojson
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.core.footprint import polygon_to_geojson
+from dataset.core.mesh import LabelledMesh, concatenate_meshes
+from dataset.core.truth import Building, BuildingTruth, FacadeTruth
+from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 from dataset.generate import GenerateConfig, generate_preset
-from dataset.mesh import LabelledMesh, concatenate_meshes
-from dataset.scene import read_scene
-from dataset.truth import Building, BuildingTruth, FacadeTruth
-from dataset.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.scenes.scene import read_scene
 
 BOX_SIZE_M = (20.0, 12.0, 9.0)
 BOX_FLOORS = 3

@@ -28,16 +28,16 @@ from conftest import make_box_building
 
 from baselines import wwr2ds, wwr2dss
 from dataset import generate, importer
-from dataset.mesh import LabelledMesh, write_labelled_ply
-from dataset.meta_data import read_meta_data, write_meta_data
-from dataset.results import read_result
-from dataset.scene import read_scene
-from dataset.scene_writer import GenerateConfig, generate_scene
-from dataset.warnings_summary import summarise_warnings
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
+from dataset.core.results import read_result
+from dataset.core.warnings_summary import summarise_warnings
+from dataset.importers.meta_data import read_meta_data, write_meta_data
+from dataset.scenes.scene import read_scene
+from dataset.scenes.scene_writer import GenerateConfig, generate_scene
 from metrics import compare
 from neural3d import extract, train
 from neural3d.config import config_to_dict, preset_config
-from neural3d.normalisation import Normalisation
+from neural3d.field.normalisation import Normalisation
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINES = {"2D-S": wwr2ds.main, "2D-SS": wwr2dss.main}
@@ -108,7 +108,7 @@ def test_unknown_class_id_in_a_train_view_stops_training(scene, tmp_path, capsys
 
 def test_degenerate_corners_skip_the_view_with_a_reason(scene, capsys):
     """A facade squashed to one pixel row has no quadrilateral: its facade is missing, said so."""
-    from dataset.images import read_labels, write_labels
+    from dataset.scenes.images import read_labels, write_labels
 
     path = scene / "semantics" / IDEAL
     labels = read_labels(path)
@@ -127,7 +127,7 @@ def test_degenerate_corners_skip_the_view_with_a_reason(scene, capsys):
 
 
 def test_every_view_degenerate_is_an_error_not_a_number(scene, capsys):
-    from dataset.images import write_labels
+    from dataset.scenes.images import write_labels
 
     for path in (scene / "semantics").glob("ideal_*.png"):
         write_labels(path, np.zeros((64, 64)))
@@ -463,7 +463,7 @@ def test_generate_interrupted_then_rerun(sig, seed, tmp_path):
 
 @pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
 def test_train_interrupted_then_resumed(sig, seed, clean_scene, tmp_path):
-    from neural3d.checkpoint import read_checkpoint
+    from neural3d.field.checkpoint import read_checkpoint
 
     runs = tmp_path / "runs"
     argv = ["neural3d.train", "--scene", clean_scene, "--preset", "tiny", "--iterations", "20",

@@ -6,8 +6,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.camera import Intrinsics, look_at, project_world_to_image
-from dataset.cameras import (
+from dataset.core.camera import Intrinsics, look_at, project_world_to_image
+from dataset.core.classes import SemanticClass
+from dataset.core.mesh import LabelledMesh, concatenate_meshes
+from dataset.core.truth import Building
+from dataset.rendering.cameras import (
     FacadeViewConfig,
     OrbitConfig,
     ideal_views,
@@ -15,10 +18,7 @@ from dataset.cameras import (
     orbit_view_failures,
     sample_orbit_views,
 )
-from dataset.classes import SemanticClass
-from dataset.mesh import LabelledMesh, concatenate_meshes
-from dataset.render import Raycaster, render_ground_truth
-from dataset.truth import Building
+from dataset.rendering.render import Raycaster, render_ground_truth
 
 K = Intrinsics.from_fov(128, 128, 60.0)
 

@@ -12,8 +12,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
 # Importers that issue 17 works on at the same time as this check was written; their frame
-# splits are converted to dataset.protocols' names when both branches meet.
-PENDING = {"dataset/buildnet3d.py", "dataset/meta_data.py"}
+# splits are converted to dataset.core.protocols' names when both branches meet.
+PENDING = {"dataset/importers/buildnet3d.py", "dataset/importers/meta_data.py"}
 
 
 def sources() -> list[Path]:
@@ -52,14 +52,14 @@ def test_protocol_and_split_names_are_spelled_only_in_dataset_protocols():
             continue
         spelled += [f"{name}:{line} {value!r}" for line, value in code_strings(path)
                     if value in ("ideal", "multi", "train", "eval")]
-    assert spelled and all(s.startswith("dataset/protocols.py:") for s in spelled), spelled
+    assert spelled and all(s.startswith("dataset/core/protocols.py:") for s in spelled), spelled
 
 
 def test_the_class_palette_is_defined_once():
     # the class colours written out, e.g. (40, 110, 230), and the colour of unknown ids
     colours = where(r"\(\s*40,\s*110,\s*230\s*\)|\(\s*200,\s*200,\s*200\s*\)|"
                     r"\(\s*255,\s*0,\s*255\s*\)")
-    assert len(colours) == 2 and all(c.startswith("dataset/classes.py:") for c in colours)
+    assert len(colours) == 2 and all(c.startswith("dataset/core/classes.py:") for c in colours)
 
 
 def test_each_default_is_assigned_once():

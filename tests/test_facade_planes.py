@@ -1,18 +1,19 @@
-"""neural3d.facade_planes: planes of a meshed box and each triangle's shadow on them."""
+"""neural3d.extraction.facade_planes: planes of a meshed box and each triangle's shadow on them."""
 
 import numpy as np
 import pytest
 from sdf_shapes import banded_labels, box_sdf
 
-from dataset.classes import FACADE_CLASSES
-from neural3d.facade_planes import (
+from dataset.core.classes import FACADE_CLASSES
+from neural3d.extraction.facade_planes import (
     azimuth_offset,
     circular_mean_deg,
     face_normals,
     project_onto_facade_planes,
 )
-from neural3d.measure import MeasureConfig, class_area_m2, group_facade_faces
-from neural3d.meshing import extract_mesh, label_vertices
+from neural3d.extraction.measure import class_area_m2, group_facade_faces
+from neural3d.extraction.measure_config import MeasureConfig
+from neural3d.extraction.meshing import extract_mesh, label_vertices
 
 
 def _box_sdf(p):

@@ -5,7 +5,7 @@ import io
 import sys
 import textwrap
 
-from dataset.method import ENTRY_POINT_GROUP, installed_methods
+from dataset.core.method import ENTRY_POINT_GROUP, installed_methods
 from metrics.compare import main
 from metrics.tables import read_csv_rows
 
@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.classes import SemanticClass
-from dataset.images import read_labels
-from dataset.method import Method
-from dataset.results import MethodResult
-from dataset.wwr import wwr_from_areas
+from dataset.core.classes import SemanticClass
+from dataset.scenes.images import read_labels
+from dataset.core.method import Method
+from dataset.core.results import MethodResult
+from dataset.core.wwr import wwr_from_areas
 
 
 @dataclass(frozen=True)

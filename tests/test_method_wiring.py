@@ -1,4 +1,4 @@
-"""metrics and figures know methods only through dataset.method.Method: no name checks."""
+"""metrics and figures know methods only through dataset.core.method.Method: no name checks."""
 
 import re
 from pathlib import Path

@@ -29,8 +29,8 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     assert n3d.code == ("dataset", "neural3d") and s2dss.code == ("dataset", "baselines")
     assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
     # the whole extraction config keys the cache, so a result measured otherwise is redone
-    from neural3d.extract_config import ExtractConfig
-    from neural3d.measure import MeasureConfig
+    from neural3d.extraction.extract_config import ExtractConfig
+    from neural3d.extraction.measure_config import MeasureConfig
 
     assert n3d.config["measure"] == asdict(MeasureConfig())
     (default,) = method_specs(("neural3d",), (), tmp_path)

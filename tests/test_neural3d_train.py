@@ -10,10 +10,10 @@ import torch
 from conftest import BOX_SIZE_M
 from neural3d_scene import write_ring_scene
 
-from neural3d.checkpoint import read_checkpoint
 from neural3d.config import preset_config
+from neural3d.field.checkpoint import read_checkpoint
+from neural3d.field.trained import load_trained_field
 from neural3d.train import lr_factor, main, train
-from neural3d.trained import load_trained_field
 
 CPU = torch.device("cpu")
 SHORT = replace(preset_config("tiny"), iterations=100, eval_every=50, checkpoint_every=50)
