@@ -37,13 +37,14 @@ from dataset.core.device import resolve_device  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
 from neural3d.field.trained import TrainedField, build_field  # noqa: E402
-from neural3d.train import make_optimizer, train, train_step  # noqa: E402
+from neural3d.train import train  # noqa: E402
 from neural3d.training.data import (  # noqa: E402
     background_class,
     frames_to_pixels,
     load_frames,
     scene_normalisation,
 )
+from neural3d.training.step import make_optimizer, train_step  # noqa: E402
 
 WWR_TARGET_PCT = 5.0
 IOU_TARGET = 0.96

@@ -33,8 +33,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from dataset.presets import build_building, preset_recipes  # noqa: E402
-from dataset.rendering.cameras import OrbitConfig, sample_orbit_views  # noqa: E402
 from dataset.rendering.facade_patches import facade_patches  # noqa: E402
+from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views  # noqa: E402
 from dataset.rendering.render import Raycaster, render_ground_truth, render_rgb, render_view  # noqa: E402
 from dataset.scenes.images import (  # noqa: E402
     write_depth_m,

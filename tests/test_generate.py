@@ -17,8 +17,8 @@ from dataset.generate import (
     main,
     scene_seed,
 )
-from dataset.rendering.cameras import OrbitConfig
-from dataset.rendering.cameras import sample_orbit_views as real_sample_orbit_views
+from dataset.rendering.orbit_views import OrbitConfig
+from dataset.rendering.orbit_views import sample_orbit_views as real_sample_orbit_views
 from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import scene_changes
 

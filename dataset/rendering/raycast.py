@@ -3,7 +3,7 @@
 Everything that casts rays at a building -- rendering (:mod:`dataset.rendering.render`), visibility
 from outside (:mod:`dataset.rendering.visibility`), footprint sections
 (:mod:`dataset.rendering.section`),
-camera checks (:mod:`dataset.rendering.cameras`) and the importers -- goes through
+camera checks (:mod:`dataset.rendering.orbit_views`) and the importers -- goes through
 :class:`Raycaster`,
 so they all see the same hits.
 

@@ -34,13 +34,8 @@ from dataset.core.provenance import (
 from dataset.core.scene_record import Frame, Scene
 from dataset.core.truth import Building, write_building
 from dataset.executors.worker_pool import worker_pool
-from dataset.rendering.cameras import (
-    FacadeViewConfig,
-    OrbitConfig,
-    ideal_views,
-    multi_views,
-    sample_orbit_views,
-)
+from dataset.rendering.facade_views import FacadeViewConfig, ideal_views, multi_views
+from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views
 from dataset.rendering.render import Raycaster, render_view
 from dataset.rendering.shading import RgbConfig
 from dataset.scenes.images import (

@@ -18,7 +18,7 @@ sys.path.insert(0, str(ROOT))
 
 from dataset.core.camera import Intrinsics, look_at  # noqa: E402
 from dataset.presets import build_building, preset_recipes  # noqa: E402
-from dataset.rendering.cameras import point_of_interest_m  # noqa: E402
+from dataset.rendering.orbit_views import point_of_interest_m  # noqa: E402
 from dataset.rendering.render import Raycaster, render_view  # noqa: E402
 
 # background, wall, window, roof, door, other (RGB)
