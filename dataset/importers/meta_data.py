@@ -14,7 +14,8 @@ sdfstudio's file: top-level ``camera_model``, ``height``, ``width``, ``has_mono_
   ``rgb_path`` under ``images/`` and ``segmentation_path`` under ``semantic/``.
 
 Segmentation images keep the source's class ids (or colours) on disk, and the scene
-declares the source's class list, so :func:`dataset.scenes.labels.read_frame_labels` remaps them
+declares the source's class list, so :func:`dataset.scenes.scene_validation.read_frame_labels`
+remaps them
 (:mod:`dataset.scenes.labels`).
 """
 
@@ -102,7 +103,8 @@ def read_meta_data(
     scene
         Frames with OpenGL ``world_from_camera`` and paths relative to the file's folder
         (segmentation images still in the source's ids, and ``semantic_classes`` the
-        source's class names, so :func:`dataset.scenes.labels.read_frame_labels` remaps them);
+        source's class names, so :func:`dataset.scenes.scene_validation.read_frame_labels` remaps
+        them);
         split ``train`` unless a frame says otherwise. ``extra`` keeps ``scene_box``,
         ``worldtogt`` and other top-level keys.
     mapping
