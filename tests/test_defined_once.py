@@ -1,8 +1,8 @@
 """Each name and default is defined in one place: a grep over the project's sources shows it.
 
 Protocol and split names, the class palette, the merge decimals, the field's chunk size, the
-marching-cubes resolution and a scene's name each have one definition; everything else
-imports it. Read from the sources (string literals, assignments), not by importing.
+marching-cubes resolution, a scene's name, face normals and in-plane bases each have one
+definition; everything else imports it. Read from the sources, not by importing.
 """
 
 import ast
@@ -67,6 +67,11 @@ def test_each_default_is_assigned_once():
                     r"^\s+resolution: int = 256", r"^CLASS_RGB\b", r"^UNKNOWN_CLASS_RGB\b",
                     r"^Split\s*=", r"^SPLITS\b", r"^PROTOCOLS\b"):
         assert len(where(pattern)) == 1, (pattern, where(pattern))
+    # face normals and in-plane bases: one helper each (dataset.core.mesh)
+    for pattern in (r"^def triangle_normals\(", r"^def plane_bases\(",
+                    r"helper = np\.where\(np\.abs\(normals"):
+        assert len(where(pattern)) == 1, (pattern, where(pattern))
+    assert where(r"^def face_normals\(") == []
     # no chunk size or merge precision written as a number elsewhere
     assert where(r"\b1 << 1[5-9]\b") == where(r"^DEFAULT_CHUNK_POINTS\s*=")
     assert where(r"np\.round\([^)]*,\s*9\)") == []

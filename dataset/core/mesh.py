@@ -75,16 +75,31 @@ class LabelledMesh:
 
     def face_normals(self) -> np.ndarray:
         """(F, 3) float64 outward unit normals (zero for degenerate faces)."""
-        t = self.triangles_m
-        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-        length = np.linalg.norm(n, axis=1, keepdims=True)
-        return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+        return triangle_normals(self.triangles_m)
 
     def to_trimesh(self):
         """A ``trimesh.Trimesh`` (no processing, so faces keep their order)."""
         import trimesh
 
         return trimesh.Trimesh(self.vertices_m, self.faces, process=False)
+
+
+def triangle_normals(triangles_m: np.ndarray) -> np.ndarray:
+    """(F, 3) unit normals of (F, 3, 3) triangles (right-hand winding: counter-clockwise seen
+    from the side the normal points to); zero for a degenerate triangle."""
+    n = np.cross(triangles_m[:, 1] - triangles_m[:, 0], triangles_m[:, 2] - triangles_m[:, 0])
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
+
+
+def plane_bases(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(F, 3) and (F, 3) unit vectors ``u``, ``v`` spanning each plane, with ``(u, v, n)``
+    right-handed for the (F, 3) unit normals ``n`` (zero for a zero normal)."""
+    helper = np.where(np.abs(normals[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    u = np.cross(helper, normals)
+    length = np.linalg.norm(u, axis=1, keepdims=True)
+    u = np.divide(u, length, out=np.zeros_like(u), where=length > 0)
+    return u, np.cross(normals, u)
 
 
 def triangle_areas_m2(triangles_m: np.ndarray) -> np.ndarray:

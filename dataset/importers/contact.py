@@ -17,7 +17,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from dataset.core.mesh import LabelledMesh
+from dataset.core.mesh import LabelledMesh, plane_bases
 
 PLANE_DECIMALS_NORMAL = 6  # faces whose unit normals agree to 1e-6 are parallel
 PLANE_DECIMALS_OFFSET_M = 5  # ... and whose plane offsets agree to 10 um, coplanar
@@ -56,7 +56,7 @@ def split_touching_faces(
     tri = mesh.triangles_m
     offsets = np.einsum("ij,ij->i", normals, tri[:, 0])
     lo, hi = tri.min(axis=1), tri.max(axis=1)
-    basis_u, basis_v = _plane_bases(normals)
+    basis_u, basis_v = plane_bases(normals)
     extent = hi - lo  # a face flat along an axis overlaps along it whatever its bounds
     keys = np.concatenate([np.round(normals, PLANE_DECIMALS_NORMAL) + 0.0,
                            np.round(offsets, PLANE_DECIMALS_OFFSET_M)[:, None] + 0.0], axis=1)
@@ -119,11 +119,4 @@ def split_touching_faces(
             parent, twins)
 
 
-def _plane_bases(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(F, 3) and (F, 3) unit vectors spanning each face's plane, right-handed with its
-    (F, 3) unit normal (zero for a zero normal)."""
-    helper = np.where(np.abs(normals[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
-    u = np.cross(helper, normals)
-    length = np.linalg.norm(u, axis=1, keepdims=True)
-    u = np.divide(u, length, out=np.zeros_like(u), where=length > 0)
-    return u, np.cross(normals, u)
+

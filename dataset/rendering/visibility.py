@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm import tqdm
 
+from dataset.core.mesh import plane_bases
+
 if TYPE_CHECKING:
     from dataset.rendering.raycast import Raycaster
 
@@ -111,10 +113,7 @@ def escape_fractions(
 
 def _to_world(local: np.ndarray, normals: np.ndarray) -> np.ndarray:
     """(F, K, 3) directions: ``local`` (K, 3) hemisphere about +z turned about each normal."""
-    helper = np.where(np.abs(normals[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
-    u = np.cross(helper, normals)
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    v = np.cross(normals, u)
+    u, v = plane_bases(normals)
     return (
         local[None, :, 0:1] * u[:, None, :]
         + local[None, :, 1:2] * v[:, None, :]

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dataset.core.mesh import triangle_normals
 from neural3d.extraction.measure_config import MeasureConfig
 
 
@@ -60,7 +61,7 @@ def project_onto_facade_planes(
     group : (F,) facade group from ``neural3d.extraction.measure.group_facade_faces`` (-1 none)
     config : ``neural3d.extraction.measure_config.MeasureConfig``
     """
-    normal = face_normals(vertices_m[faces])
+    normal = triangle_normals(vertices_m[faces])
     centroid_xy = vertices_m[faces].mean(axis=1)[:, :2]
     idx = np.flatnonzero(facade_area_m2 > 0)
     taken: list[int] = []
@@ -154,10 +155,3 @@ def circular_mean_deg(angle_deg: np.ndarray, weight: np.ndarray) -> float:
 def wrap_deg(delta_deg: np.ndarray) -> np.ndarray:
     """Angle differences wrapped into [-180, 180)."""
     return (delta_deg + 180.0) % 360.0 - 180.0
-
-
-def face_normals(triangles_m: np.ndarray) -> np.ndarray:
-    """(F, 3) unit normals of (F, 3, 3) triangles (right-hand winding); zero if degenerate."""
-    n = np.cross(triangles_m[:, 1] - triangles_m[:, 0], triangles_m[:, 2] - triangles_m[:, 0])
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    return np.divide(n, length, out=np.zeros_like(n), where=length > 0)

@@ -52,12 +52,11 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
 from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
-from dataset.core.mesh import triangle_areas_m2
+from dataset.core.mesh import triangle_areas_m2, triangle_normals
 from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 from neural3d.extraction.facade_planes import (
     azimuth_offset,
     circular_mean_deg,
-    face_normals,
     project_onto_facade_planes,
     wrap_deg,
 )
@@ -143,7 +142,7 @@ def group_facade_faces(
 def _group_faces(vertices_m: np.ndarray, faces: np.ndarray, facade_area: np.ndarray,
                  config: MeasureConfig) -> np.ndarray:
     """:func:`group_facade_faces` on checked inputs and (F,) facade-class areas in m²."""
-    normal = face_normals(vertices_m[faces])
+    normal = triangle_normals(vertices_m[faces])
     horizontal = np.linalg.norm(normal[:, :2], axis=1)
     candidate = (facade_area > 0) & (horizontal >= np.cos(np.radians(config.facade_max_tilt_deg)))
     group = np.full(len(faces), -1, dtype=np.int64)
@@ -233,7 +232,7 @@ def _facade_figures(
                           (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
     weight = a[:, list(FACADE_CLASSES)].sum(axis=1)
     azimuth, offset = plane if plane is not None else azimuth_offset(
-        face_normals(tri), tri.mean(axis=1)[:, :2], weight)
+        triangle_normals(tri), tri.mean(axis=1)[:, :2], weight)
     azimuth, offset = float(azimuth), float(offset)
     u = np.array([np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))])
     height = float(tri[..., 2].max() - tri[..., 2].min())

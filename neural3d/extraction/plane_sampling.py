@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dataset.core.classes import SemanticClass
-from neural3d.extraction.facade_planes import face_normals
+from dataset.core.mesh import triangle_normals
 
 SdfFn = Callable[[np.ndarray], np.ndarray]  # (N, 3) world m -> (N,) m, positive outside
 LabelFn = Callable[[np.ndarray], np.ndarray]  # (N, 3) world m -> (N,) dataset class ids
@@ -68,7 +68,7 @@ def plane_extents(vertices_m: np.ndarray, faces: np.ndarray,
     are left out.
     """
     tri = vertices_m[faces]
-    normal = face_normals(tri)
+    normal = triangle_normals(tri)
     centroid = tri.mean(axis=1)
     out = []
     for az, off in planes:
