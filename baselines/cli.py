@@ -15,11 +15,12 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from baselines.views import PROTOCOLS
-from dataset.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
-from dataset.results import MethodResult, write_result
-from dataset.scene import Scene, read_scene
-from dataset.warnings_summary import summarise_warnings
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
+from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.results import MethodResult, write_result
+from dataset.core.scene_record import Scene
+from dataset.core.warnings_summary import summarise_warnings
+from dataset.scenes.scene import read_scene
 
 
 def scene_folders(data: Path) -> list[Path]:
@@ -53,7 +54,7 @@ def default_results_folder(data: Path) -> Path:
 
 def add_common_arguments(parser: argparse.ArgumentParser) -> None:
     """--views, --data, --out, --debug-images and --debug."""
-    parser.add_argument("--views", required=True, choices=PROTOCOLS,
+    parser.add_argument("--views", required=True, choices=VIEW_PROTOCOLS,
                         help="view protocol: 'ideal' (one perpendicular view per facade) or "
                              "'multi' (several natural views per facade)")
     parser.add_argument("--data", required=True, type=Path,
@@ -102,5 +103,5 @@ def run_scenes(data: Path, out: Path | None, run_one: Callable[[Scene], MethodRe
 
 def main_guarded(prog: str, body: Callable[[], int], debug: bool = False) -> int:
     """Run a CLI body: a user's mistake becomes one line on stderr and exit 2
-    (:func:`dataset.cli_errors.run_cli`)."""
+    (:func:`dataset.core.cli_errors.run_cli`)."""
     return run_cli(prog, body, debug=debug)

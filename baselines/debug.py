@@ -14,14 +14,14 @@ import cv2
 import numpy as np
 
 from baselines.rectify import OUTSIDE
-from dataset.images import write_rgb
+from dataset.core.classes import CLASS_RGB
+from dataset.scenes.images import write_rgb
 
 Kind = Literal["mask", "corners", "rectified"]
 
-# RGB colours of class ids 0..5 (background, wall, window, roof, door, other) and OUTSIDE.
+# RGB colours of the class ids (dataset.core.classes.CLASS_RGB) and of OUTSIDE.
 _PALETTE = np.zeros((256, 3), dtype=np.uint8)
-_PALETTE[:6] = [(0, 0, 0), (200, 200, 200), (40, 110, 230), (170, 60, 50), (140, 90, 40),
-                (60, 160, 70)]
+_PALETTE[:len(CLASS_RGB)] = CLASS_RGB
 _PALETTE[OUTSIDE] = (255, 255, 255)
 
 

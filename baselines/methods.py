@@ -1,13 +1,22 @@
-"""2D-S and 2D-SS as benchmark methods (:class:`dataset.method.Method`)."""
+"""2D-S and 2D-SS as benchmark methods (:class:`dataset.core.method.Method`)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
-from dataset.method import Method
-from dataset.protocols import VIEW_PROTOCOLS
+from dataset.core.method import Method
+from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.scene_record import Scene
 
 LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")
+
+
+def debug_images_2dss(scene: Scene, protocol: str, config: Wwr2dssConfig, folder: Path) -> None:
+    """Run 2D-SS on ``scene`` only to write its pipeline images into ``folder``."""
+    run_2dss(scene, protocol, config, debug_dir=folder)
+
 
 METHOD_2DS = Method(
     name="2D-S", inputs=("semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
@@ -18,4 +27,5 @@ METHOD_2DSS = Method(
     name="2D-SS", inputs=("rgb", "semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
     config_type=Wwr2dssConfig, run=run_2dss, packages=("baselines",), libraries=LIBRARIES,
     description="facade plane by RANSAC, rectified facade, WWR in the rectified mask",
+    debug_images=debug_images_2dss,
 )

@@ -13,13 +13,12 @@ from typing import Literal
 
 import numpy as np
 
-from dataset.camera import Intrinsics
-from dataset.protocols import VIEW_PROTOCOLS, ViewProtocol
-from dataset.scene import Frame, Scene
-from dataset.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
+from dataset.core.camera import Intrinsics
+from dataset.core.protocols import VIEW_PROTOCOLS, ViewProtocol
+from dataset.core.scene_record import Frame, Scene, scene_name
+from dataset.scenes.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
 
-Protocol = ViewProtocol  # the 2D methods' protocols (dataset.protocols)
-PROTOCOLS: tuple[str, ...] = VIEW_PROTOCOLS
+Protocol = ViewProtocol  # the 2D methods' protocols (dataset.core.protocols)
 
 
 class ViewError(ValueError):
@@ -74,11 +73,6 @@ class LoadedViews:
             self.skipped.setdefault(facade_id, []).append(reason)
 
 
-def scene_name(scene: Scene) -> str:
-    """Name of a scene in result files and warnings: its folder name."""
-    return scene.root.resolve().name
-
-
 def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "optional",
                "no"]) -> LoadedViews:
     """Read the semantic (and depth) images of every frame of ``protocol``.
@@ -95,8 +89,8 @@ def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "
     ValueError
         If ``protocol`` is not "ideal" or "multi", or the scene has no frame of it.
     """
-    if protocol not in PROTOCOLS:
-        raise ValueError(f"unknown view protocol {protocol!r}; expected one of {PROTOCOLS}")
+    if protocol not in VIEW_PROTOCOLS:
+        raise ValueError(f"unknown view protocol {protocol!r}; expected one of {VIEW_PROTOCOLS}")
     if depth not in ("required", "optional", "no"):
         raise ValueError(f"depth must be 'required', 'optional' or 'no', got {depth!r}")
     name = scene_name(scene)

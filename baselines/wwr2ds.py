@@ -26,12 +26,12 @@ from baselines.aggregate import COMBINES, Combine, building_result, combine_valu
 from baselines.cli import add_common_arguments, main_guarded, run_scenes
 from baselines.debug import colour_labels, write_debug_image
 from baselines.facade_mask import facade_class_mask, isolate_facade_2ds
-from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
-from dataset.classes import SemanticClass
-from dataset.cli_errors import check_output_folder
-from dataset.results import FacadeEstimate, MethodResult
-from dataset.scene import Scene
-from dataset.wwr import wwr_from_areas
+from baselines.views import FacadeView, Protocol, ViewError, load_views
+from dataset.core.classes import SemanticClass
+from dataset.core.cli_errors import check_output_folder
+from dataset.core.results import FacadeEstimate, MethodResult
+from dataset.core.scene_record import Scene, scene_name
+from dataset.core.wwr import wwr_from_areas
 
 METHOD = "2D-S"
 

@@ -56,12 +56,12 @@ from baselines.rectify import (
     rectified_wwr,
     rectify_labels,
 )
-from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
-from dataset.cli_errors import check_output_folder
-from dataset.device import resolve_device
-from dataset.images import read_rgb
-from dataset.results import FacadeEstimate, MethodResult
-from dataset.scene import Scene
+from baselines.views import FacadeView, Protocol, ViewError, load_views
+from dataset.core.cli_errors import check_output_folder
+from dataset.core.device import resolve_device
+from dataset.core.results import FacadeEstimate, MethodResult
+from dataset.core.scene_record import Scene, scene_name
+from dataset.scenes.images import read_rgb
 
 METHOD = "2D-SS"
 

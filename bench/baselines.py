@@ -44,9 +44,10 @@ from baselines.wwr2dss import (  # noqa: E402
     rectify_views,
     run_2dss,
 )
-from dataset.atomic import write_text_atomic  # noqa: E402
-from dataset.protocols import VIEW_PROTOCOLS  # noqa: E402
-from dataset.scene import Scene, read_scene  # noqa: E402
+from dataset.core.atomic import write_text_atomic  # noqa: E402
+from dataset.core.protocols import VIEW_PROTOCOLS  # noqa: E402
+from dataset.core.scene_record import Scene  # noqa: E402
+from dataset.scenes.scene import read_scene  # noqa: E402
 from metrics.aggregate import aggregate_by_family  # noqa: E402
 from metrics.errors import building_errors, failed_building  # noqa: E402
 from metrics.report import table2_errors  # noqa: E402

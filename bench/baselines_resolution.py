@@ -3,7 +3,7 @@
     python bench/baselines_resolution.py --data /tmp/h4_paper --family skyscraper --factors 1,2,4
 
 Re-renders the ideal (or multi) views of every scene of one family from its
-``mesh.ply`` with ``dataset.render.render_ground_truth``, at the same poses
+``mesh.ply`` with ``dataset.rendering.render.render_ground_truth``, at the same poses
 and field of view with the intrinsics scaled by each factor, writes them as a
 scene folder (label and millimetre-depth PNGs, as the benchmark stores them)
 in a temporary folder, and runs the unchanged 2D-SS on it. Prints, per factor,
@@ -29,11 +29,12 @@ from tqdm import tqdm  # noqa: E402
 
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
-from dataset.images import write_depth_m, write_labels  # noqa: E402
-from dataset.mesh import read_labelled_ply  # noqa: E402
-from dataset.protocols import VIEW_PROTOCOLS  # noqa: E402
-from dataset.render import Raycaster, render_ground_truth  # noqa: E402
-from dataset.scene import Frame, Scene, read_scene, write_transforms  # noqa: E402
+from dataset.core.mesh import read_labelled_ply  # noqa: E402
+from dataset.core.protocols import VIEW_PROTOCOLS  # noqa: E402
+from dataset.core.scene_record import Frame, Scene  # noqa: E402
+from dataset.rendering.render import Raycaster, render_ground_truth  # noqa: E402
+from dataset.scenes.images import write_depth_m, write_labels  # noqa: E402
+from dataset.scenes.scene import read_scene, write_transforms  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 
 

@@ -40,15 +40,16 @@ from pathlib import Path
 
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
-from dataset.atomic import write_text_atomic  # noqa: E402
+from dataset.core.atomic import write_text_atomic  # noqa: E402
+from dataset.core.results import MethodResult  # noqa: E402
+from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
 from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
-from dataset.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
-from dataset.results import MethodResult  # noqa: E402
 from metrics.benchmark_cache import DefaultBenchmark  # noqa: E402
 from metrics.compare import compare  # noqa: E402
 from metrics.executors import make_executor  # noqa: E402
-from metrics.methods import Neural3dBudget, method_specs  # noqa: E402
+from metrics.methods import method_specs  # noqa: E402
 from metrics.runner import Job, MethodSpec, find_scenes, run_job, run_missing  # noqa: E402
+from neural3d.method import Neural3dBudget  # noqa: E402
 
 NODES = (1, 2, 4, 8, 16, 32, 64)
 
@@ -197,7 +198,7 @@ def main(argv: list[str] | None = None) -> int:
                             eval_frames=1)
 
     def specs_for(results: Path) -> list[MethodSpec]:
-        return method_specs(methods, ("ideal", "multi"), results, neural3d=budget)
+        return method_specs(methods, ("ideal", "multi"), results, configs={"neural3d": budget})
 
     with tempfile.TemporaryDirectory(prefix="cluster-bench-") as tmp:
         tmp = Path(tmp)

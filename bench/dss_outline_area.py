@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
-from dataset.scene import read_scene  # noqa: E402
+from dataset.scenes.scene import read_scene  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 
 

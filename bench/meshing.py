@@ -1,4 +1,5 @@
-"""Time and peak memory of marching-cubes extractions at 256³ and 512³ (neural3d.meshing).
+"""Time and peak memory of marching-cubes extractions at 256³ and 512³
+(neural3d.extraction.meshing).
 
     python bench/meshing.py                      # analytic L-shaped building, 256 and 512
     python bench/meshing.py --resolutions 128 256 --run runs/x --device cuda   # a trained field
@@ -43,8 +44,8 @@ def _band_labels(p: np.ndarray) -> np.ndarray:
 
 def run_one(resolution: int, run_dir: str | None, device: str) -> dict:
     """Extract once in this process; return times (s), sizes and peak RSS (MB)."""
-    from neural3d.measure import measure_semantic_mesh
-    from neural3d.meshing import extract_mesh, label_vertices
+    from neural3d.extraction.measure import measure_semantic_mesh
+    from neural3d.extraction.meshing import extract_mesh, label_vertices
 
     rss_before_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     if run_dir is None:
@@ -54,7 +55,7 @@ def run_one(resolution: int, run_dir: str | None, device: str) -> dict:
         import torch
 
         from neural3d.extract import field_label_fn, field_sdf_fn
-        from neural3d.trained import load_trained_field
+        from neural3d.field.trained import load_trained_field
 
         dev = torch.device(device)
         field = load_trained_field(Path(run_dir), device=dev)

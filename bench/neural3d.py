@@ -32,18 +32,19 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 
-from dataset.atomic import write_json_atomic  # noqa: E402
-from dataset.device import resolve_device  # noqa: E402
-from dataset.scene import read_scene  # noqa: E402
+from dataset.core.atomic import write_json_atomic  # noqa: E402
+from dataset.core.device import resolve_device  # noqa: E402
+from dataset.scenes.scene import read_scene  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
-from neural3d.data import (  # noqa: E402
+from neural3d.field.trained import TrainedField, build_field  # noqa: E402
+from neural3d.train import train  # noqa: E402
+from neural3d.training.data import (  # noqa: E402
     background_class,
     frames_to_pixels,
     load_frames,
     scene_normalisation,
 )
-from neural3d.train import make_optimizer, train, train_step  # noqa: E402
-from neural3d.trained import TrainedField, build_field  # noqa: E402
+from neural3d.training.step import make_optimizer, train_step  # noqa: E402
 
 WWR_TARGET_PCT = 5.0
 IOU_TARGET = 0.96
@@ -143,7 +144,7 @@ def _on_target(row: dict) -> bool:
 
 
 def converge(args: argparse.Namespace) -> dict:
-    from neural3d.extract_config import ExtractConfig
+    from neural3d.extraction.extract_config import ExtractConfig
 
     device = resolve_device(args.device)
     config = replace(with_overrides(preset_config("fast"), args.set),

@@ -22,13 +22,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 from shapely.geometry import shape
 
-from dataset.mesh import LabelledMesh, triangle_areas_m2
+from dataset.core.mesh import LabelledMesh, triangle_areas_m2
 from dataset.presets import build_building, preset_recipes
 from metrics.facade_match import match_facades
 from neural3d.extract import facade_estimates
-from neural3d.footprint import footprint_from_sdf
-from neural3d.measure import MeasureConfig, measure_semantic_mesh
-from neural3d.meshing import extract_mesh, label_vertices
+from neural3d.extraction.footprint import footprint_from_sdf
+from neural3d.extraction.measure import measure_semantic_mesh
+from neural3d.extraction.measure_config import MeasureConfig
+from neural3d.extraction.meshing import extract_mesh, label_vertices
 
 CANDIDATE_FACES = 8  # nearest surface samples whose triangles are tested exactly
 

@@ -1,11 +1,11 @@
-"""Renderer speed and memory (dataset.render, dataset.generate); prints the figures.
+"""Renderer speed and memory (dataset.rendering.render, dataset.generate); prints the figures.
 
     python bench/render.py            # per-image times, one whole building, tiny preset x 2 workers
     python bench/render.py --full     # + the whole paper preset with 2 workers (long)
 
 Per-image figures are single-process with BLAS/OpenMP pinned to one thread:
 the median over 5 orbit views of each ``tiny`` building at 512 x 512, after one
-warm-up render. "Whole building" runs :func:`dataset.scene_writer.generate_scene`
+warm-up render. "Whole building" runs :func:`dataset.scenes.scene_writer.generate_scene`
 in this process (rendering plus PNG writing of all five modalities). The preset
 runs go through the CLI in a subprocess with ``--workers 2``; their peak memory
 is the largest sum of resident memory over the process tree, polled every 0.2 s.
@@ -32,18 +32,18 @@ from pathlib import Path  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from dataset.cameras import OrbitConfig, sample_orbit_views  # noqa: E402
-from dataset.facade_patches import facade_patches  # noqa: E402
-from dataset.images import (  # noqa: E402
+from dataset.presets import build_building, preset_recipes  # noqa: E402
+from dataset.rendering.facade_patches import facade_patches  # noqa: E402
+from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views  # noqa: E402
+from dataset.rendering.render import Raycaster, render_ground_truth, render_rgb, render_view  # noqa: E402
+from dataset.scenes.images import (  # noqa: E402
     write_depth_m,
     write_facade_ids,
     write_labels,
     write_normals,
     write_rgb,
 )
-from dataset.presets import build_building, preset_recipes  # noqa: E402
-from dataset.render import Raycaster, render_ground_truth, render_rgb, render_view  # noqa: E402
-from dataset.scene_writer import GenerateConfig, generate_scene  # noqa: E402
+from dataset.scenes.scene_writer import GenerateConfig, generate_scene  # noqa: E402
 
 
 def per_image(resolution: int) -> dict[str, float]:

@@ -1,7 +1,7 @@
 """Generate benchmark scene folders: ``python -m dataset.generate --preset tiny --out data/tiny``.
 
 One scene folder per building, named by the building id, written by
-:func:`dataset.scene_writer.generate_scene` (atomically: a folder with the
+:func:`dataset.scenes.scene_writer.generate_scene` (atomically: a folder with the
 final name is always finished). This module runs a whole preset (optionally
 in several processes, one building each) or a user's mesh, and is the CLI.
 A rerun skips finished scenes whose provenance record (config, seed, inputs,
@@ -22,11 +22,12 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
-from dataset.import_config import add_import_arguments
-from dataset.ray_tasks import RayConfig, add_executor_arguments
-from dataset.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
-from dataset.scene_writer import (
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
+from dataset.executors.ray_tasks import RayConfig, add_executor_arguments
+from dataset.executors.worker_pool import worker_pool
+from dataset.importers.import_config import add_import_arguments
+from dataset.scenes.scene_writer import (
     GenerateConfig,
     PlannedView,
     depth_unit_for,
@@ -36,7 +37,6 @@ from dataset.scene_writer import (
     scene_changes,
     scene_is_finished,
 )
-from dataset.worker_pool import worker_pool
 
 __all__ = [
     "GenerateConfig",
@@ -242,7 +242,7 @@ def main(argv: list[str] | None = None) -> int:
                              "use --workers to split one building's frames over processes")
         check_output_folder(args.out)
         if args.buildnet3d is not None:
-            from dataset.buildnet3d import import_buildnet3d
+            from dataset.importers.buildnet3d import import_buildnet3d
 
             scenes = import_buildnet3d(args.buildnet3d, args.out, overwrite=args.overwrite)
         elif args.preset is not None:
@@ -279,7 +279,7 @@ def _check_resources(args: argparse.Namespace, config: GenerateConfig) -> None:
 
 
 def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
-    from dataset.import_source import import_from_args, import_inputs
+    from dataset.importers.import_source import import_from_args, import_inputs
 
     building = import_from_args(args)
     check_writable(args.out)

@@ -21,11 +21,12 @@ from typing import Literal
 import numpy as np
 from tqdm import tqdm
 
-from dataset.cli_errors import add_debug_flag, run_cli
-from dataset.l_shaped import make_l_shaped, sample_l_shaped_params
-from dataset.realistic import REALISTIC_MODELS, make_realistic, sample_realistic_params
-from dataset.skyscraper import make_skyscraper, sample_skyscraper_params
-from dataset.truth import Building, BuildingTruth
+from dataset.core.cli_errors import add_debug_flag, run_cli
+from dataset.core.truth import Building, BuildingTruth
+from dataset.families.l_shaped import make_l_shaped, sample_l_shaped_params
+from dataset.families.realistic import make_realistic, sample_realistic_params
+from dataset.families.realistic_params import REALISTIC_MODELS
+from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_params
 
 Family = Literal["skyscraper", "l_shaped", "realistic"]
 FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic")

@@ -2,7 +2,7 @@
 
 Each task builds its building from the recipe, renders the scene folder into
 a temporary folder on the worker and returns it packed
-(:mod:`dataset.folder_pack`); this process unpacks it into ``out_root``
+(:mod:`dataset.executors.folder_pack`); this process unpacks it into ``out_root``
 atomically, so a folder with the final name is always finished, and a rerun
 skips it. A building that fails (it cannot be framed) stops the run as with
 the local pool: the tasks not yet collected are cancelled.
@@ -15,10 +15,10 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from dataset.atomic import atomic_directory
-from dataset.folder_pack import pack_folder, unpack_folder
-from dataset.ray_tasks import RayConfig, TaskLost, TaskResources, ray_session, run_tasks
-from dataset.scene_writer import GenerateConfig, generate_scene
+from dataset.core.atomic import atomic_directory
+from dataset.executors.folder_pack import pack_folder, unpack_folder
+from dataset.executors.ray_tasks import RayConfig, TaskLost, TaskResources, ray_session, run_tasks
+from dataset.scenes.scene_writer import GenerateConfig, generate_scene
 
 if TYPE_CHECKING:
     from dataset.presets import BuildingRecipe

@@ -6,7 +6,7 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
-from dataset.truth import BuildingTruth, read_building
+from dataset.core.truth import BuildingTruth, read_building
 from figures.style import MissingInput
 from metrics.aggregate import ALL_FAMILIES, family_rank
 from metrics.tables import Table

@@ -14,8 +14,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from shapely.geometry import MultiPolygon, Polygon
 
-from dataset.footprint import geojson_to_polygon
-from dataset.truth import BuildingTruth
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.truth import BuildingTruth
 from figures.style import MissingInput
 from metrics.errors import footprint_iou
 from metrics.plots import save_figure

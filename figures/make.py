@@ -14,12 +14,12 @@ from collections.abc import Callable, Sequence
 from datetime import datetime, timezone
 from pathlib import Path
 
-from dataset.atomic import write_json_atomic
-from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
-from dataset.results import code_version
+from dataset.core.atomic import write_json_atomic
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.results import code_version
 from figures.dataset_table import read_truths, table1_dataset
 from figures.footprints import footprint_pairs, plot_footprint_overlays
-from figures.meshes import neural3d_meshes, plot_reconstructed_meshes
+from figures.meshes import plot_reconstructed_meshes, reconstructed_meshes
 from figures.pipeline import plot_2dss_pipeline
 from figures.renders import plot_example_renders
 from figures.style import MissingInput
@@ -63,7 +63,7 @@ def make_figures(data: Path | None, results: Path, out: Path) -> dict[str, list[
         "dataset_renders": lambda stem: plot_example_renders(truths, stem),
         "2dss_pipeline": lambda stem: plot_2dss_pipeline(results / PIPELINE_FOLDER, stem),
         "neural3d_meshes": lambda stem: plot_reconstructed_meshes(
-            neural3d_meshes(results, data), stem),
+            reconstructed_meshes(results, data), stem),
         "footprint_overlays": lambda stem: plot_footprint_overlays(
             footprint_pairs(truths, results / FOOTPRINTS_FOLDER), stem),
         "errors_by_family": lambda stem: plot_errors_by_family(aggregate_by_family(rows()), stem),

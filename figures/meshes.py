@@ -1,14 +1,14 @@
-"""Reconstructed semantic meshes (neural3d) rendered from a few angles, beside the true mesh.
+"""Reconstructed semantic meshes (neural3d's) rendered from a few angles, beside the true mesh.
 
-Reads ``neural3d_runs.json`` that ``metrics.compare`` writes (it points at each
-run's ``mesh.ply``) and, when the scene is there, the scene's true ``mesh.ply``.
-Rendering is exact ray casting (:mod:`dataset.render`) with class colours and
+Reads the ``<method>_runs.json`` files that ``metrics.compare`` writes for
+methods that keep a mesh (neural3d; :mod:`metrics.mesh_pointers`) and, when
+the scene is there, the scene's true ``mesh.ply``.
+Rendering is exact ray casting (:mod:`dataset.rendering.render`) with class colours and
 simple Lambert shading.
 """
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,11 +16,13 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.camera import Intrinsics, look_at
-from dataset.classes import NO_FACADE
-from dataset.mesh import LabelledMesh, read_labelled_ply
-from dataset.render import Raycaster, render_ground_truth
-from figures.style import CLASS_RGB, MissingInput
+from dataset.core.camera import Intrinsics, look_at
+from dataset.core.classes import NO_FACADE
+from dataset.core.mesh import LabelledMesh, read_labelled_ply
+from dataset.core.semantic_ply import read_semantic_ply
+from dataset.rendering.render import Raycaster, render_ground_truth
+from figures.style import CLASS_RGB_ARRAY, MissingInput
+from metrics.mesh_pointers import read_mesh_pointers
 from metrics.plots import save_figure
 
 
@@ -67,7 +69,7 @@ def render_mesh_views(
         light /= np.linalg.norm(light)
         lambert = np.clip(gt.normals_world @ light, 0, 1)
         shade = config.ambient + (1 - config.ambient) * lambert
-        rgb = CLASS_RGB[np.minimum(gt.labels, len(CLASS_RGB) - 1)] * shade[..., None]
+        rgb = CLASS_RGB_ARRAY[np.minimum(gt.labels, len(CLASS_RGB_ARRAY) - 1)] * shade[..., None]
         rgb[gt.depth_z_m <= 0] = 255
         images.append(np.clip(rgb, 0, 255).astype(np.uint8))
     return images
@@ -75,27 +77,25 @@ def render_mesh_views(
 
 def read_reconstruction(path: str | Path) -> LabelledMesh:
     """A neural3d ``mesh.ply`` (per-vertex labels) as a mesh with per-face labels."""
-    from neural3d.meshing import read_semantic_ply
 
     vertices, faces, labels, _ = read_semantic_ply(path)
     return LabelledMesh(vertices, faces, face_labels_from_vertices(faces, labels),
                         np.full(len(faces), NO_FACADE))
 
 
-def neural3d_meshes(compare_out: Path, data: Path | None) -> list[tuple[str, Path, Path | None]]:
-    """(scene, reconstructed mesh, true mesh or None) of each neural3d run with a mesh."""
-    pointers = compare_out / "neural3d_runs.json"
-    if not pointers.is_file():
-        raise MissingInput(f"{pointers} does not exist; run `python -m metrics.compare` first")
-    runs = json.loads(pointers.read_text()).get("runs", [])
+def reconstructed_meshes(compare_out: Path,
+                         data: Path | None) -> list[tuple[str, Path, Path | None]]:
+    """(label, reconstructed mesh, true mesh or None) of each method's run with a mesh;
+    the label is ``scene\nmethod``."""
     out = []
-    for run in runs:
-        mesh = Path(run["mesh"])
-        if mesh.is_file():
-            truth = data / run["scene"] / "mesh.ply" if data is not None else None
-            out.append((run["scene"], mesh, truth if truth and truth.is_file() else None))
+    for run in read_mesh_pointers(compare_out):
+        if run.mesh.is_file():
+            truth = data / run.scene / "mesh.ply" if data is not None else None
+            out.append((f"{run.scene}\n{run.method}", run.mesh,
+                        truth if truth and truth.is_file() else None))
     if not out:
-        raise MissingInput("no neural3d mesh yet (no finished neural3d run in the comparison)")
+        raise MissingInput("no reconstructed mesh yet (no finished run of a method that "
+                           "keeps one, such as neural3d, in the comparison)")
     return out
 
 
@@ -105,9 +105,10 @@ def plot_reconstructed_meshes(
 ) -> list[Path]:
     """Rows: each scene's reconstruction (and its true mesh below it), one column per angle."""
     rows = []
-    for scene, recon, truth in meshes:
-        rows.append((f"{scene}\nneural3d", render_mesh_views(read_reconstruction(recon), config)))
+    for label, recon, truth in meshes:
+        rows.append((label, render_mesh_views(read_reconstruction(recon), config)))
         if truth is not None:
+            scene = label.split("\n")[0]
             rows.append((f"{scene}\ntruth", render_mesh_views(read_labelled_ply(truth), config)))
     cols = len(config.azimuths_deg)
     fig = Figure(figsize=(2.0 * cols, 2.0 * len(rows)), layout="constrained")

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from dataset.images import read_rgb
+from dataset.scenes.images import read_rgb
 from figures.style import MissingInput
 from metrics.plots import save_figure
 

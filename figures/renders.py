@@ -8,15 +8,18 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.images import read_depth_m, read_labels, read_normals, read_rgb
-from dataset.scene import Frame, Scene, read_scene
-from dataset.truth import BuildingTruth
+from dataset.core.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
+from dataset.core.scene_record import Frame, Scene
+from dataset.core.truth import BuildingTruth
+from dataset.scenes.images import read_depth_m, read_labels, read_normals, read_rgb
+from dataset.scenes.scene import read_scene
 from figures.style import MissingInput, colour_depth, colour_labels, colour_normals
 from metrics.aggregate import family_rank
 from metrics.plots import save_figure
 
 MODALITIES = ("colour", "semantics", "normals", "depth")
-PREFERRED_SPLITS = ("eval", "train", "multi", "ideal")  # an orbit view shows the whole building
+# an orbit view shows the whole building
+PREFERRED_SPLITS = (EVAL_SPLIT, TRAIN_PROTOCOL, MULTI_PROTOCOL, IDEAL_PROTOCOL)
 
 
 def example_views(

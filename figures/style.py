@@ -4,11 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.classes import CLASS_RGB as _CLASS_RGB
-from dataset.classes import NUM_CLASSES
+from dataset.core.classes import CLASS_RGB, NUM_CLASSES, UNKNOWN_CLASS_RGB
 
-CLASS_RGB = np.array(_CLASS_RGB, dtype=np.uint8)  # (NUM_CLASSES, 3): dataset.classes.CLASS_RGB
-UNKNOWN_CLASS_RGB = (255, 0, 255)  # ids beyond the known classes stand out
+CLASS_RGB_ARRAY = np.array(CLASS_RGB, dtype=np.uint8)  # (NUM_CLASSES, 3)
 
 
 class MissingInput(ValueError):
@@ -16,7 +14,7 @@ class MissingInput(ValueError):
 
 
 def colour_labels(labels: np.ndarray) -> np.ndarray:
-    """(H, W) class ids -> (H, W, 3) uint8 colours (:data:`CLASS_RGB`)."""
+    """(H, W) class ids -> (H, W, 3) uint8 colours (:data:`dataset.core.classes.CLASS_RGB`)."""
     palette = np.tile(np.array(UNKNOWN_CLASS_RGB, dtype=np.uint8), (256, 1))
     palette[:NUM_CLASSES] = CLASS_RGB
     return palette[np.asarray(labels, dtype=np.uint8)]

@@ -8,12 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.protocols import PROTOCOLS
-from dataset.truth import BUILDING_TYPES
+from dataset.core.protocols import PROTOCOLS
+from dataset.core.truth import BUILDING_TYPES
 from metrics.errors import BuildingErrors
+from metrics.methods import METHODS
 
 ALL_FAMILIES = "all"  # the family label of the row that pools every family
-METHOD_ORDER = ("2D-S", "2D-SS", "neural3d")
+METHOD_ORDER = METHODS  # the built-in methods, in the order they are declared
 PROTOCOL_ORDER = PROTOCOLS
 
 
@@ -139,7 +140,8 @@ def family_rank(family: str) -> tuple[int, str]:
 
 
 def method_rank(method: str) -> tuple[int, str]:
-    """Sort key: 2D-S, 2D-SS, neural3d, then other methods by name."""
+    """Sort key: the built-in methods in their order (``metrics.methods.METHODS``), then the
+    others by name."""
     return (METHOD_ORDER.index(method), method) if method in METHOD_ORDER else (99, method)
 
 

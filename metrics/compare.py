@@ -5,8 +5,9 @@ into a cache folder on first use, every method, both view protocols, neural3d
 for a short CPU budget). With ``--data`` it compares on a benchmark or a
 user's scenes. Outputs (``--out``): the tables as CSV, Markdown and LaTeX,
 per-building and per-facade CSVs, plots (PNG + PDF), ``provenance.json``, the
-estimated footprints, the 2D-SS pipeline images of one facade and
-``neural3d_runs.json`` pointing at neural3d's meshes: everything ``figures.make`` reads;
+estimated footprints, the 2D-SS pipeline images of one facade and, for each
+method that keeps a mesh (neural3d), ``<method>_runs.json`` pointing at its
+meshes: everything ``figures.make`` reads;
 then ``report.html``, all of it in one offline page (:mod:`metrics.html_report`).
 """
 
@@ -21,16 +22,16 @@ from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
 
-from dataset.atomic import atomic_directory, write_json_atomic, write_text_atomic
-from dataset.cli_errors import check_output_folder, run_cli
+from dataset.core.atomic import atomic_directory, write_json_atomic, write_text_atomic
+from dataset.core.cli_errors import check_output_folder, run_cli
+from dataset.core.device import resolve_device
+from dataset.core.results import code_version
+from dataset.core.truth import BuildingTruth, read_building
 from dataset.degrade.spec import parse_specs
-from dataset.device import resolve_device
-from dataset.ray_tasks import RayConfig
-from dataset.results import code_version
-from dataset.truth import BuildingTruth, read_building
+from dataset.executors.ray_tasks import RayConfig
 from metrics.aggregate import aggregate_by_family
 from metrics.benchmark_cache import DefaultBenchmark, ensure_benchmark
-from metrics.compare_args import parse_compare_args
+from metrics.compare_args import neural3d_config, parse_compare_args, study_config
 from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import (
     NO_TRUTH_FAMILY,
@@ -43,13 +44,8 @@ from metrics.errors import failed_building as failed_row
 from metrics.executors import make_executor
 from metrics.explain import explain, methods_provenance_text, run_timings
 from metrics.html_report import write_report
-from metrics.methods import (
-    Neural3dBudget,
-    debug_images_2dss,
-    list_methods,
-    method_specs,
-    neural3d_extract_dir,
-)
+from metrics.mesh_pointers import write_mesh_pointers
+from metrics.methods import list_methods, method_specs
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report import (
     per_building_table,
@@ -58,12 +54,11 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
-from metrics.robustness import RobustnessStudy, robustness_table, run_study, study_budget
+from metrics.robustness import RobustnessStudy, robustness_table, run_study
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
 
 PROVENANCE_FILE = "provenance.json"
-NEURAL3D_POINTERS_FILE = "neural3d_runs.json"
 PIPELINE_FOLDER = "2dss_pipeline"
 FOOTPRINTS_FOLDER = "footprints"
 PLOTS_FOLDER = "plots"
@@ -130,9 +125,11 @@ def compare(
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
     _write_plots(groups, rows, out_dir / PLOTS_FOLDER)
     _write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
-    _write_neural3d_pointers(scene_dirs, results_dir, out_dir)
-    if allow_run and any(s.name == "2D-SS" for s in specs):
-        _keep_pipeline_images(scene_dirs, specs, out_dir / PIPELINE_FOLDER)
+    for spec in specs:
+        write_mesh_pointers(scene_dirs, spec, out_dir)
+    with_images = [s for s in specs if s.debug_images is not None]
+    if allow_run and with_images:
+        _keep_pipeline_images(scene_dirs, with_images[0], out_dir / PIPELINE_FOLDER)
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
     _write_html_report(out_dir)
     return comparison
@@ -226,37 +223,23 @@ def _write_footprints(outcomes: Sequence[Outcome], folder: Path) -> None:
                                   o.result.footprint)
 
 
-def _write_neural3d_pointers(scene_dirs: Sequence[Path], results_dir: Path, out: Path) -> None:
-    runs = []
-    for scene_dir in scene_dirs:
-        extract_dir = neural3d_extract_dir(results_dir, scene_dir.name)
-        if (extract_dir / "mesh.ply").is_file():
-            footprint = extract_dir / "footprint.geojson"
-            runs.append({
-                "scene": scene_dir.name,
-                "run_dir": str(extract_dir.parent.resolve()),
-                "mesh": str((extract_dir / "mesh.ply").resolve()),
-                "footprint": str(footprint.resolve()) if footprint.is_file() else None,
-            })
-    write_json_atomic(out / NEURAL3D_POINTERS_FILE, {"runs": runs})
-
-
-def _keep_pipeline_images(
-    scene_dirs: Sequence[Path], specs: Sequence[MethodSpec], folder: Path
-) -> None:
-    """Keep the 2D-SS debug images of one facade (the first view of the first scene's facade 1)."""
+def _keep_pipeline_images(scene_dirs: Sequence[Path], spec: MethodSpec, folder: Path) -> None:
+    """Keep ``spec``'s debug images (2D-SS's) of one facade (the first view of the first
+    scene's facade 1)."""
     if folder.is_dir() and any(folder.glob("*.png")):
         return
-    protocol = next(s for s in specs if s.name == "2D-SS").protocols[0]
+    assert spec.debug_images is not None
+    protocol = spec.protocols[0]
     for scene_dir in scene_dirs:
         if not (scene_dir / "transforms.json").is_file():
             continue
         tmp = folder.with_name(f".{folder.name}.tmp")
         shutil.rmtree(tmp, ignore_errors=True)
         try:
-            debug_images_2dss(scene_dir, protocol, tmp)
+            spec.debug_images(scene_dir, protocol, tmp)
         except Exception as exc:  # the figure is optional; the comparison is not
-            print(f"2D-SS pipeline images skipped: {type(exc).__name__}: {exc}", file=sys.stderr)
+            print(f"{spec.name} pipeline images skipped: {type(exc).__name__}: {exc}",
+                  file=sys.stderr)
             shutil.rmtree(tmp, ignore_errors=True)
             return
         images = sorted(tmp.glob("*.png"))
@@ -285,29 +268,22 @@ def main(argv: Sequence[str] | None = None) -> int:
             resolve_device(args.device)  # a Ray cluster's GPUs are on its nodes, not here
         execute = make_executor(args.executor, RayConfig(address=args.ray_address))
         default = DefaultBenchmark() if args.data is None else None
-        resolution = _given_or(args.neural3d_resolution,
-                               default.neural3d_resolution if default else None)
-        steps = _given_or(args.neural3d_steps, default.neural3d_steps if default else None)
-        budget = Neural3dBudget(
-            preset=args.neural3d_preset, steps=steps, max_minutes=args.neural3d_max_minutes,
-            threads=args.neural3d_threads, resolution=resolution,
-            eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
-        )
+        configs = {"neural3d": neural3d_config(args, default)}
         if args.explain:
-            return _explain(args, default, methods, views, budget)
+            return _explain(args, default, methods, views, configs)
         if default is not None:
-            print(default.announce(methods, budget.steps), flush=True)
+            print(default.announce(methods, configs["neural3d"].steps), flush=True)
         data = (ensure_benchmark(default) if default is not None else args.data).resolve()
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
         check_output_folder(results, "--results")
         check_output_folder(out, "--out")
         if args.robustness:
-            budget = study_budget(budget)
+            configs = study_config(configs)
             study = RobustnessStudy(seed=args.degrade_seed,
-                                    neural3d_levels=args.robustness_neural3d)
+                                    heavy_levels=args.robustness_neural3d)
             rows = run_study(data, results / "robustness", out / "robustness",
-                             lambda r: method_specs(methods, views, r, neural3d=budget), study,
+                             lambda r: method_specs(methods, views, r, configs=configs), study,
                              compare)
             print(to_text(robustness_table(rows)))
             print(f"wrote robustness.csv/.md/.png to {out / 'robustness'}")
@@ -316,7 +292,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             degradation = parse_specs(args.degrade, seed=args.degrade_seed)
             run = degraded_run(data, results, out, degradation)
             data, results, out = run.data, run.results, run.out
-        specs = method_specs(methods, views, results, neural3d=budget)
+        specs = method_specs(methods, views, results, configs=configs)
         if args.degrade:
             specs = with_degradation(specs, degradation)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
@@ -335,13 +311,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         "interrupted: finished results are kept; run again to continue"))
 
 
-def _given_or(given: int | None, fallback: int | None) -> int | None:
-    """A CLI value when given (0 included, so that the budget refuses it), else the fallback."""
-    return fallback if given is None else given
-
-
 def _explain(args: argparse.Namespace, default: DefaultBenchmark | None,
-             methods: tuple[str, ...], views: tuple[str, ...], budget: Neural3dBudget) -> int:
+             methods: tuple[str, ...], views: tuple[str, ...], configs: dict) -> int:
     """``--explain SCENE METHOD``: print one scene's result records of one method."""
     scene, method = args.explain
     data = (default.folder if default is not None else args.data).resolve()
@@ -349,7 +320,7 @@ def _explain(args: argparse.Namespace, default: DefaultBenchmark | None,
     scene_dir = next((d for d in find_scenes(data) if d.name == scene), None)
     if scene_dir is None:
         raise ValueError(f"no scene {scene!r} in {data}")
-    (spec,) = method_specs((method,), views, results, neural3d=budget)
+    (spec,) = method_specs((method,), views, results, configs=configs)
     print(explain(scene_dir, spec, results))
     return 0
 

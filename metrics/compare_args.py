@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
-from dataset.cli_errors import add_debug_flag
+from dataset.core.cli_errors import add_debug_flag
+from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.degrade.spec import DEGRADATIONS
-from dataset.protocols import VIEW_PROTOCOLS
-from dataset.ray_tasks import add_executor_arguments
+from dataset.executors.ray_tasks import add_executor_arguments
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
-from metrics.methods import METHODS, Neural3dBudget
+from metrics.methods import METHODS
+from neural3d.method import Neural3dBudget
 
 
 def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
@@ -88,3 +91,37 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
                            "building, method and views")
     add_debug_flag(parser)
     return parser.parse_args(argv)
+
+
+def neural3d_config(args: argparse.Namespace, default: DefaultBenchmark | None) -> Neural3dBudget:
+    """neural3d's config from the ``--neural3d-*`` options and ``--device``; the built-in
+    default run (``default``) fills the step budget, resolution and eval frames not given.
+
+    Raises
+    ------
+    ValueError
+        If a value is out of range (0 steps included: a given 0 is not 'not given').
+    """
+    resolution = _given_or(args.neural3d_resolution,
+                           default.neural3d_resolution if default else None)
+    steps = _given_or(args.neural3d_steps, default.neural3d_steps if default else None)
+    return Neural3dBudget(
+        preset=args.neural3d_preset, steps=steps, max_minutes=args.neural3d_max_minutes,
+        threads=args.neural3d_threads, resolution=resolution,
+        eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
+    )
+
+
+def study_config(configs: Mapping[str, Any]) -> dict[str, Any]:
+    """The configs of a robustness study: neural3d with the given step budget, else the
+    built-in default's (:attr:`DefaultBenchmark.neural3d_steps`), one eval frame, and the
+    default run's marching-cubes resolution unless one was given."""
+    budget = configs["neural3d"]
+    return {**configs, "neural3d": replace(
+        budget, steps=budget.steps or DefaultBenchmark.neural3d_steps, eval_frames=1,
+        resolution=budget.resolution or DefaultBenchmark.neural3d_resolution)}
+
+
+def _given_or(given: int | None, fallback: int | None) -> int | None:
+    """A CLI value when given (0 included, so that the budget refuses it), else the fallback."""
+    return fallback if given is None else given

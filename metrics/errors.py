@@ -16,9 +16,9 @@ import shapely
 from shapely.geometry import MultiPolygon, Polygon
 from shapely.ops import unary_union
 
-from dataset.footprint import geojson_to_polygon
-from dataset.results import MethodResult
-from dataset.truth import BuildingTruth
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.results import MethodResult
+from dataset.core.truth import BuildingTruth
 from metrics.facade_match import has_facade_geometry, match_facades
 
 Status = Literal["ok", "failed"]

@@ -21,9 +21,9 @@ from dataclasses import replace
 from functools import partial
 from pathlib import Path
 
-from dataset.atomic import atomic_directory
-from dataset.folder_pack import pack_folder, unpack_folder
-from dataset.ray_tasks import (
+from dataset.core.atomic import atomic_directory
+from dataset.executors.folder_pack import pack_folder, unpack_folder
+from dataset.executors.ray_tasks import (
     EXECUTORS,
     ExecutorName,
     RayConfig,

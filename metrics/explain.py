@@ -1,7 +1,7 @@
 """Where a comparison's figures came from, in words: table footers, run timings, ``--explain``.
 
 Every text here is made from the methods' specs and the results' provenance
-records (:mod:`dataset.provenance`), never from the clock, so tables that carry
+records (:mod:`dataset.core.provenance`), never from the clock, so tables that carry
 it stay byte-identical between reruns.
 """
 
@@ -12,8 +12,8 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
-from dataset.provenance import code_version, provenance_changes
-from dataset.results import read_result, result_filename
+from dataset.core.provenance import code_version, provenance_changes
+from dataset.core.results import read_result, result_filename
 from metrics.errors import RunTiming
 from metrics.runner import MethodSpec, Outcome, expected_provenance
 

@@ -3,7 +3,7 @@
 Methods that find facades without ground truth (neural3d groups its mesh by
 normal direction) number them 1..K in their own order. Evaluation pairs them
 with the truth by where they are, from each estimate's ``normal`` and
-``centre_m`` (world frame, :class:`dataset.results.FacadeEstimate`) and the
+``centre_m`` (world frame, :class:`dataset.core.results.FacadeEstimate`) and the
 truth's ``building.json``:
 
 1. the truth's walls are the outlines in ``BuildingTruth.facade_outlines_m`` (one
@@ -15,7 +15,7 @@ truth's ``building.json``:
    so it ranks after every wall with an outline, by normal angle;
 3. several estimates on one truth facade (segments of a curved wall, a wall the
    method split) are merged: window and facade areas add up, WWR is recomputed
-   with :func:`dataset.wwr.wwr_from_areas`, widths add and the largest
+   with :func:`dataset.core.wwr.wwr_from_areas`, widths add and the largest
    height stays;
 4. a truth facade no estimate reaches is reported missing; an estimate whose
    normal agrees with no truth facade is left out with a reason.
@@ -31,9 +31,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 from shapely.geometry import Point, Polygon
 
-from dataset.results import FacadeEstimate
-from dataset.truth import BuildingTruth
-from dataset.wwr import wwr_from_areas
+from dataset.core.results import FacadeEstimate
+from dataset.core.truth import BuildingTruth
+from dataset.core.wwr import wwr_from_areas
 
 MAX_NORMAL_ANGLE_DEG = 45.0  # an estimate may face a truth facade only if normals agree this well
 

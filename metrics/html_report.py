@@ -2,7 +2,7 @@
 
 Reads what :mod:`metrics.compare` wrote to its output folder (the tables'
 CSVs, ``per_building.csv``, ``provenance.json``, ``footprints/``,
-``2dss_pipeline/``, ``neural3d_runs.json``) and the scenes named in the
+``2dss_pipeline/``, ``<method>_runs.json``) and the scenes named in the
 provenance, and writes ``report.html`` there: plotly.js and every image are
 embedded, so the file opens offline and can be sent on its own.
 """
@@ -15,8 +15,10 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from dataset.atomic import write_text_atomic
-from dataset.footprint import geojson_to_polygon
+from dataset.core.atomic import write_text_atomic
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.protocols import IDEAL_PROTOCOL
+from dataset.core.semantic_ply import read_semantic_ply
 from metrics.aggregate import Summary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
 from metrics.html_sections import (
@@ -33,6 +35,7 @@ from metrics.html_sections import (
     sortable_table,
 )
 from metrics.mesh_decimate import decimate_vertex_clustering
+from metrics.mesh_pointers import MeshRun, read_mesh_pointers
 from metrics.reference import REFERENCE_KEYS, REFERENCE_LABEL, reference_table2
 from metrics.report import PER_BUILDING_NAME, TABLE2_NAME, TABLE3_NAME, read_building_errors_csv
 from metrics.tables import format_cell, read_csv_rows
@@ -230,7 +233,7 @@ def _images(scene: str, scene_dir: Path, out_dir: Path) -> list[str]:
     transforms = scene_dir / "transforms.json"
     if transforms.is_file():
         frames = json.loads(transforms.read_text()).get("frames", [])
-        ideal = [f for f in frames if f.get("split") == "ideal"] or frames[:1]
+        ideal = [f for f in frames if f.get("split") == IDEAL_PROTOCOL] or frames[:1]
         if ideal and (scene_dir / ideal[0]["file_path"]).is_file():
             out.append(image_tag(scene_dir / ideal[0]["file_path"], "render (first ideal view)"))
     for png in sorted((out_dir / "2dss_pipeline").glob(f"{scene}__*.png")):
@@ -253,23 +256,23 @@ def _footprints(scene: str, scene_dir: Path, out_dir: Path) -> str:
 
 
 def _mesh_viewer(scene: str, out_dir: Path) -> str:
-    """neural3d's semantic mesh of ``scene`` (decimated), drawn when the building is opened."""
-    from neural3d.meshing import read_semantic_ply
+    """The semantic meshes of ``scene`` (decimated; ``<method>_runs.json``, neural3d's), drawn
+    when the building is opened."""
+    return "".join(_one_mesh(run, i) for i, run in enumerate(
+        r for r in read_mesh_pointers(out_dir) if r.scene == scene))
 
-    pointers = out_dir / "neural3d_runs.json"
-    runs = json.loads(pointers.read_text()).get("runs", []) if pointers.is_file() else []
-    run = next((r for r in runs if r.get("scene") == scene), None)
-    if run is None:
-        return ""
+
+def _one_mesh(run: MeshRun, index: int) -> str:
     try:
-        vertices, faces, labels, _ = read_semantic_ply(run["mesh"])
+        vertices, faces, labels, _ = read_semantic_ply(run.mesh)
     except ValueError as exc:
-        return f'<p class="muted">neural3d mesh unreadable: {esc(exc)}</p>'
+        return f'<p class="muted">{esc(run.method)} mesh unreadable: {esc(exc)}</p>'
     n_faces = len(faces)
     vertices, faces, labels = decimate_vertex_clustering(vertices, faces, labels, MAX_MESH_FACES)
-    title = f"neural3d semantic mesh ({len(faces)} of {n_faces} faces)"
-    return (f'<h4>neural3d mesh</h4><div class="mesh-wrap">'
-            f'{chart(f"mesh-{scene}", mesh_figure_json(vertices, faces, labels, title), 460)}'
+    title = f"{run.method} semantic mesh ({len(faces)} of {n_faces} faces)"
+    chart_id = f"mesh-{run.scene}" + (f"-{index}" if index else "")
+    return (f'<h4>{esc(run.method)} mesh</h4><div class="mesh-wrap">'
+            f'{chart(chart_id, mesh_figure_json(vertices, faces, labels, title), 460)}'
             f"</div>")
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
 
-from dataset.classes import CLASS_NAMES, CLASS_RGB
+from dataset.core.classes import CLASS_NAMES, CLASS_RGB, UNKNOWN_CLASS_RGB
 
 SVG_SIZE_PX = 320
 SVG_MARGIN_PX = 10
@@ -111,11 +111,11 @@ def mesh_figure_json(vertices_m: np.ndarray, faces: np.ndarray, vertex_labels: n
     """Plotly ``mesh3d`` figure JSON of a labelled mesh, vertices coloured by class.
 
     vertices_m : (V, 3) float, faces : (F, 3) int, vertex_labels : (V,) int class ids.
-    Colours are :data:`dataset.classes.CLASS_RGB`; ids beyond it are magenta.
+    Colours are :data:`dataset.core.classes.CLASS_RGB`; ids beyond it are magenta.
     """
     import plotly.graph_objects as go
 
-    palette = np.array([*CLASS_RGB, (255, 0, 255)])
+    palette = np.array([*CLASS_RGB, UNKNOWN_CLASS_RGB])
     labels = np.minimum(np.asarray(vertex_labels, dtype=int), len(CLASS_RGB))
     colours = [f"rgb({r},{g},{b})" for r, g, b in palette[labels]]
     v = np.round(np.asarray(vertices_m, dtype=float), 3)

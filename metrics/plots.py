@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.atomic import write_bytes_atomic
-from dataset.results import code_version
+from dataset.core.atomic import write_bytes_atomic
+from dataset.core.results import code_version
 from metrics.aggregate import GroupSummary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
 

@@ -12,17 +12,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
-from dataset.atomic import write_text_atomic
+from dataset.core.atomic import write_text_atomic
 from dataset.degrade.spec import DegradeSpec
 from metrics.aggregate import method_rank, protocol_rank
-from metrics.benchmark_cache import DefaultBenchmark
 from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import BuildingErrors
-from metrics.methods import Neural3dBudget
-from metrics.robustness_plot import plot_robustness
+from metrics.robustness_plot import RobustnessRow, plot_robustness
 from metrics.runner import MethodSpec
 from metrics.tables import Table, to_csv, to_markdown
 
@@ -34,8 +32,9 @@ SpecsFor = Callable[[Path], list[MethodSpec]]
 class RobustnessStudy:
     """Degradations and severities of the study (a laptop's worth on the tiny benchmark).
 
-    ``neural3d_levels``: ``"all"`` runs neural3d at every severity, ``"max"`` only
-    at the highest of each degradation (the default; the 2D methods always run at all).
+    ``heavy_levels``: ``"all"`` runs the heavy methods (``Method.heavy``: neural3d) at
+    every severity, ``"max"`` only at the highest of each degradation (the default; the
+    2D methods always run at all).
     """
 
     levels: tuple[tuple[str, tuple[float, ...]], ...] = (
@@ -45,30 +44,15 @@ class RobustnessStudy:
         ("depth_noise", (0.25, 0.5, 1.0)),
     )
     seed: int = 0
-    neural3d_levels: str = "max"
+    heavy_levels: str = "max"
 
     def __post_init__(self) -> None:
-        if self.neural3d_levels not in ("all", "max"):
-            raise ValueError(f"neural3d_levels must be 'all' or 'max', got "
-                             f"{self.neural3d_levels!r}")
+        if self.heavy_levels not in ("all", "max"):
+            raise ValueError(f"heavy_levels must be 'all' or 'max', got "
+                             f"{self.heavy_levels!r}")
         for name, severities in self.levels:
             for s in severities:
                 DegradeSpec(name, s, self.seed)  # type: ignore[arg-type]
-
-
-@dataclass(frozen=True)
-class RobustnessRow:
-    """Mean errors (APE, %) of one method and views under one degradation and severity."""
-
-    degradation: str
-    severity: float
-    method: str
-    protocol: str
-    buildings: int
-    failed: int
-    wwr_ape: float | None
-    window_ape: float | None
-    facade_ape: float | None
 
 
 def run_study(
@@ -89,8 +73,8 @@ def run_study(
             degradation = (DegradeSpec(name, severity, study.seed),)  # type: ignore[arg-type]
             run = degraded_run(data, results, out / "runs", degradation)
             specs = specs_for(run.results)
-            if study.neural3d_levels == "max" and severity < max(severities):
-                specs = [s for s in specs if s.name != "neural3d"]
+            if study.heavy_levels == "max" and severity < max(severities):
+                specs = [s for s in specs if not s.heavy]
             comparison = compare(run.data, with_degradation(specs, degradation), run.results,
                                  run.out, command=f"python -m metrics.compare --robustness "
                                  f"({degradation[0].text})")
@@ -102,13 +86,6 @@ def run_study(
     plot_robustness(rows, out / "robustness")
     return rows
 
-
-def study_budget(budget: Neural3dBudget) -> Neural3dBudget:
-    """neural3d's budget in the study: the given step budget, else the built-in default's
-    (:attr:`DefaultBenchmark.neural3d_steps`), one eval frame, the default run's
-    marching-cubes resolution unless one was given."""
-    return replace(budget, steps=budget.steps or DefaultBenchmark.neural3d_steps, eval_frames=1,
-                   resolution=budget.resolution or DefaultBenchmark.neural3d_resolution)
 
 
 def summarise(rows: Sequence[BuildingErrors], degradation: str,

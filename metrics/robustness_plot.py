@@ -1,11 +1,12 @@
-"""The robustness plot: error against severity, one panel per degradation, one curve per
-method and views (style and file handling of :mod:`metrics.plots`)."""
+"""The robustness study's rows (:class:`RobustnessRow`) and its plot: error against severity,
+one panel per degradation, one curve per method and views (style and file handling of
+:mod:`metrics.plots`)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -13,14 +14,26 @@ from matplotlib.figure import Figure
 from metrics.aggregate import method_rank, protocol_rank
 from metrics.plots import save_figure
 
-if TYPE_CHECKING:
-    from metrics.robustness import RobustnessRow
-
 SEVERITY_UNITS = {
     "mask_noise": "level", "occluders": "occluders per facade", "pose": "degrees",
     "depth_noise": "level", "mask_erode": "px", "mask_dilate": "px", "mask_bleed": "px",
     "mask_miss": "probability", "mask_false": "probability",
 }
+
+
+@dataclass(frozen=True)
+class RobustnessRow:
+    """Mean errors (APE, %) of one method and views under one degradation and severity."""
+
+    degradation: str
+    severity: float
+    method: str
+    protocol: str
+    buildings: int
+    failed: int
+    wwr_ape: float | None
+    window_ape: float | None
+    facade_ape: float | None
 
 
 def plot_robustness(rows: Sequence[RobustnessRow], stem: str | Path,

@@ -1,13 +1,13 @@
 """Run only the missing (scene, method, protocol) results; reuse the ones already on disk.
 
-Results are keyed by their provenance record (:mod:`dataset.provenance`): the
+Results are keyed by their provenance record (:mod:`dataset.core.provenance`): the
 method's config, the fingerprint of the code it depends on, the scene's
 fingerprint (its ``transforms.json``, which records how it was rendered) and
 library versions. A stored result is reused only when its record equals the
 one the current code would write (:func:`expected_provenance`); otherwise the
 log says which part changed and the method runs again, unless ``reuse_stale``
 keeps it on purpose (its outcome is then ``"stale"`` and the tables mark it).
-Results are written with :func:`dataset.results.write_result`, carrying the
+Results are written with :func:`dataset.core.results.write_result`, carrying the
 record. A method that raises is recorded as a failed outcome with its reason;
 the other runs go on.
 
@@ -28,9 +28,14 @@ from typing import Any, Literal
 
 from tqdm import tqdm
 
-from dataset.provenance import Provenance, file_fingerprint, make_provenance, provenance_changes
-from dataset.ray_tasks import TaskResources
-from dataset.results import MethodResult, read_result, result_filename, write_result
+from dataset.core.provenance import (
+    Provenance,
+    file_fingerprint,
+    make_provenance,
+    provenance_changes,
+)
+from dataset.core.results import MethodResult, read_result, result_filename, write_result
+from dataset.executors.ray_tasks import TaskResources
 
 RunFn = Callable[[Path, str], MethodResult]
 """(scene folder, protocol) -> the method's result for that scene; may raise."""
@@ -48,6 +53,11 @@ class MethodSpec:
     where ``run`` writes a folder per scene (named by the scene) that the
     comparison keeps (neural3d's run folder); such a ``run`` also takes an
     ``artefacts_dir=`` keyword to write it elsewhere (a worker on another machine).
+    ``mesh_file``: a semantic mesh inside a scene's artefacts folder, for the
+    figures and the report; ``heavy``: run only at the highest severity of a
+    robustness study (unless asked otherwise); ``debug_images(scene folder,
+    protocol, folder)``: write its pipeline images. All of these come from the
+    method's :class:`dataset.core.method.Method` (``metrics.methods``).
     ``code`` names the modules or packages whose source the results depend on and
     ``libraries`` the distributions whose versions they depend on: both go into
     each result's provenance record, so changing them recomputes the results.
@@ -62,6 +72,9 @@ class MethodSpec:
     artefacts_dir: Path | None = None
     code: tuple[str, ...] = ("dataset",)
     libraries: tuple[str, ...] = ("numpy",)
+    mesh_file: str | None = None
+    heavy: bool = False
+    debug_images: Callable[[Path, str, Path], None] | None = None
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dataset.atomic import write_text_atomic
+from dataset.core.atomic import write_text_atomic
 from metrics.aggregate import Summary
 
 Cell = str | int | float | Summary | None

@@ -3,13 +3,13 @@
 ``python -m neural3d.extract --run DIR`` writes, into ``DIR/extract`` (or ``--out``):
 
 - ``mesh.ply``: marching-cubes mesh, per-vertex ``label`` (argmax of the semantic
-  head, mapped to :mod:`dataset.classes` ids by the run's class names) and RGB
+  head, mapped to :mod:`dataset.core.classes` ids by the run's class names) and RGB
   from the colour network looking at the surface head-on (view direction =
   -vertex normal, so the colour does not depend on where a camera happened to be);
 - ``footprint.geojson``: zero contour of the SDF averaged over ``footprint_heights_m``;
-- ``<scene>__neural3d__train.json``: the :class:`dataset.results.MethodResult`.
+- ``<scene>__neural3d__train.json``: the :class:`dataset.core.results.MethodResult`.
 
-Facades are the mesh's own facade groups (:mod:`neural3d.measure`), numbered
+Facades are the mesh's own facade groups (:mod:`neural3d.extraction.measure`), numbered
 1..K, each with its outward normal and centre in world metres; nothing of the
 ground truth is read. Evaluation pairs them with the truth's facades
 (:mod:`metrics.facade_match`).
@@ -26,18 +26,20 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from dataset.atomic import write_json_atomic
-from dataset.classes import NUM_CLASSES, class_id_from_name
-from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
-from dataset.device import resolve_device
-from dataset.footprint import polygon_to_geojson
-from dataset.resources import check_mesh_resources
-from dataset.results import FacadeEstimate, MethodResult, code_version, write_result
-from dataset.wwr import wwr_from_areas
-from neural3d.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
-from neural3d.footprint import footprint_from_sdf
-from neural3d.measure import MeshMeasurement, measure_semantic_mesh
-from neural3d.meshing import (
+from dataset.core.atomic import write_json_atomic
+from dataset.core.classes import NUM_CLASSES, class_id_from_name
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.device import resolve_device
+from dataset.core.footprint import polygon_to_geojson
+from dataset.core.protocols import TRAIN_PROTOCOL
+from dataset.core.resources import check_mesh_resources
+from dataset.core.results import FacadeEstimate, MethodResult, code_version, write_result
+from dataset.core.semantic_ply import write_semantic_ply
+from dataset.core.wwr import wwr_from_areas
+from neural3d.extraction.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
+from neural3d.extraction.footprint import footprint_from_sdf
+from neural3d.extraction.measure import MeshMeasurement, measure_semantic_mesh
+from neural3d.extraction.meshing import (
     ColorFn,
     LabelFn,
     SdfFn,
@@ -45,12 +47,11 @@ from neural3d.meshing import (
     color_vertices,
     extract_mesh,
     label_vertices,
-    write_semantic_ply,
 )
-from neural3d.plane_sampling import plane_extents, plane_sampled_areas
+from neural3d.extraction.plane_sampling import plane_extents, plane_sampled_areas
 
 METHOD = "neural3d"
-PROTOCOL = "train"
+PROTOCOL = TRAIN_PROTOCOL
 
 
 def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
@@ -63,7 +64,8 @@ def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
 
 
 def field_label_fn(trained, device: torch.device, chunk_points: int) -> LabelFn:
-    """NumPy class-id callable (N, 3) -> (N,) :mod:`dataset.classes` ids (semantic-head argmax)."""
+    """NumPy class-id callable (N, 3) -> (N,) :mod:`dataset.core.classes` ids (semantic-head
+    argmax)."""
     class_ids = _class_ids_of(trained.class_names)
 
     def label(points_m: np.ndarray) -> np.ndarray:
@@ -112,7 +114,7 @@ def measure_field(
 
     Parameters
     ----------
-    trained : neural3d.trained.TrainedField
+    trained : neural3d.field.trained.TrainedField
     config : ExtractConfig (use a modest ``resolution``, e.g. 128, while training)
     device : where to evaluate the field; None takes ``trained.device`` if it has one, else CPU.
     progress : show a progress bar over the SDF grid.
@@ -165,7 +167,7 @@ def with_plane_sampled_areas(m: MeshMeasurement, mesh: SemanticMesh, trained,
                              config: ExtractConfig, device: torch.device) -> MeshMeasurement:
     """``m`` with its whole-building areas and WWR read on its facade planes' grids.
 
-    Per-facade figures stay the mesh's. See :mod:`neural3d.plane_sampling`.
+    Per-facade figures stay the mesh's. See :mod:`neural3d.extraction.plane_sampling`.
     """
     extents = plane_extents(mesh.vertices_m, mesh.faces,
                             tuple((f.azimuth_deg, f.offset_m) for f in m.facades),
@@ -194,7 +196,7 @@ def extract_run(
     ``out_dir`` defaults to ``run_dir / "extract"``. Everything is computed
     before anything is written, and each file is written atomically.
     """
-    from neural3d.trained import load_trained_field
+    from neural3d.field.trained import load_trained_field
 
     run_dir = Path(run_dir)
     if not run_dir.is_dir():

@@ -11,128 +11,49 @@ from __future__ import annotations
 
 import argparse
 import copy
-import csv
-import io
-import json
-import math
 import signal
 import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
-from functools import partial
+from dataclasses import replace
 from pathlib import Path
 
 import torch
 from tqdm import tqdm
 
-from dataset.atomic import write_json_atomic, write_text_atomic
-from dataset.classes import CLASS_NAMES
-from dataset.cli_errors import add_debug_flag, check_output_folder, run_cli
-from dataset.device import resolve_device
-from dataset.resources import check_training_resources
-from dataset.results import code_version
-from dataset.scene import read_scene
-from neural3d.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
-from neural3d.config import PRESETS, TrainConfig, config_from_dict, config_to_dict, preset_config
-from neural3d.data import (
-    Pixels,
+from dataset.core.atomic import write_json_atomic
+from dataset.core.classes import CLASS_NAMES
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.device import resolve_device
+from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
+from dataset.core.resources import check_training_resources
+from dataset.core.scene_record import scene_name
+from dataset.scenes.scene import read_scene
+from neural3d.config import PRESETS, TrainConfig, preset_config
+from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
+from neural3d.field.trained import TrainedField, build_field
+from neural3d.training.data import (
     background_class,
     frames_to_pixels,
     load_frames,
-    scene_name,
     scene_normalisation,
 )
-from neural3d.evaluate import eval_pixel_subset, evaluate
-from neural3d.fields import SemanticSDF
-from neural3d.losses import psnr, total_loss
-from neural3d.model import RenderOutput, render_rays
-from neural3d.normalisation import Normalisation
-from neural3d.occupancy import OccupancyGrid
-from neural3d.trained import TrainedField, build_field
+from neural3d.training.evaluate import eval_pixel_subset, evaluate
+from neural3d.training.losses import psnr
+from neural3d.training.run_folder import (
+    check_resumable,
+    read_evals,
+    read_log,
+    read_run_config,
+    start_run_folder,
+    write_log,
+)
+from neural3d.training.step import make_occupancy, make_optimizer, train_step, update_ema
 
 LOG_EVERY = 10  # steps between log.csv rows
-LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "depth", "psnr",
-              "inv_s", "lr")
 
 Callback = Callable[[int, TrainedField], "bool | None"]
-
-
-def lr_factor(step: int, config: TrainConfig) -> float:
-    """Learning-rate multiplier: linear warm-up, then cosine decay to ``lr_final_factor``."""
-    if step < config.warmup:
-        return (step + 1) / config.warmup
-    progress = min((step - config.warmup) / max(config.iterations - config.warmup, 1), 1.0)
-    return config.lr_final_factor + (1 - config.lr_final_factor) * 0.5 * (
-        1 + math.cos(math.pi * progress))
-
-
-def make_optimizer(field: torch.nn.Module, config: TrainConfig
-                   ) -> tuple[torch.optim.Adam, torch.optim.lr_scheduler.LambdaLR]:
-    """Adam over all of ``field``'s parameters and its warm-up + cosine schedule."""
-    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
-    return optimizer, torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor,
-                                                                           config=config))
-
-
-@dataclass(frozen=True)
-class StepResult:
-    """One training step: the loss (detached), its weighted parts, the batch and its render."""
-
-    loss: float
-    parts: dict[str, float]
-    pixel_index: torch.Tensor  # "(R,)" rows of the pixels the batch used
-    render: RenderOutput
-
-
-@torch.no_grad()
-def update_ema(average: torch.nn.Module, field: torch.nn.Module, decay: float) -> None:
-    """``average`` <- decay * average + (1 - decay) * field (parameters); buffers copied."""
-    for a, p in zip(average.parameters(), field.parameters()):
-        a.lerp_(p, 1.0 - decay)
-    for a, b in zip(average.buffers(), field.buffers()):
-        a.copy_(b)
-
-
-def make_occupancy(config: TrainConfig, box_min: torch.Tensor, box_max: torch.Tensor
-                   ) -> OccupancyGrid | None:
-    """The run's occupancy grid over the box "(3,)", or None when ``occupancy_resolution`` is 0."""
-    if config.occupancy_resolution == 0:
-        return None
-    return OccupancyGrid(box_min, box_max, config.occupancy_resolution)
-
-
-def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
-               scheduler: torch.optim.lr_scheduler.LRScheduler | None, pixels: Pixels,
-               box_min: torch.Tensor, box_max: torch.Tensor, config: TrainConfig, *,
-               step: int, background_class: int, generator: torch.Generator,
-               occupancy: OccupancyGrid | None = None) -> StepResult:
-    """One optimisation step at ``step`` (the only training step; the bench calls it too).
-
-    Draws ``config.rays_per_batch`` pixels with ``generator``, renders them, takes
-    the weighted loss and one optimizer (and scheduler, if given) step. With an
-    ``occupancy`` grid, rays skip empty space; the grid is refreshed from the SDF
-    at ``occupancy_start`` and every ``occupancy_every`` steps after.
-    """
-    field.set_step(step)
-    if occupancy is not None and step >= config.occupancy_start and (
-            step - config.occupancy_start) % config.occupancy_every == 0:
-        occupancy.update_from_sdf(field.sdf, margin=config.occupancy_margin_cells * occupancy.cell)
-    idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
-                        device=pixels.rgb.device)
-    out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max, config,
-                      step=step, training=True, background_class=background_class,
-                      generator=generator, occupancy=occupancy)
-    depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
-    loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
-                             background_class=background_class, depth_t=depth_t)
-    optimizer.zero_grad(set_to_none=True)
-    loss.backward()
-    optimizer.step()
-    if scheduler is not None:
-        scheduler.step()
-    return StepResult(float(loss.detach()), parts, idx, out)
 
 
 def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.device,
@@ -159,20 +80,20 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     check_training_resources(sum(
         round(f.intrinsics.width * config.image_scale) * round(f.intrinsics.height
                                                                * config.image_scale)
-        for f in scene.frames_in("train")))
-    frames = load_frames(scene, "train", image_scale=config.image_scale,
+        for f in scene.frames_in(TRAIN_PROTOCOL)))
+    frames = load_frames(scene, TRAIN_PROTOCOL, image_scale=config.image_scale,
                          with_depth=config.depth_loss)
     if resume:
-        norm = _check_resumable(run_dir, config)
+        norm = check_resumable(run_dir, config)
     else:
         norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
-        _start_run_folder(run_dir, scene_dir, CLASS_NAMES, bg, norm, config, device,
-                          len(frames))
+        start_run_folder(run_dir, scene_dir, CLASS_NAMES, bg, norm, config, device,
+                         len(frames))
     pixels = frames_to_pixels(frames, norm, device)
     eval_pixels = None
-    eval_frames = scene.frames_in("eval")
+    eval_frames = scene.frames_in(EVAL_SPLIT)
     if eval_frames:
-        chosen = load_frames(scene, "eval", image_scale=config.image_scale)
+        chosen = load_frames(scene, EVAL_SPLIT, image_scale=config.image_scale)
         pick = torch.linspace(0, len(chosen) - 1, min(config.eval_max_frames, len(chosen)))
         eval_pixels = eval_pixel_subset(
             frames_to_pixels([chosen[int(i)] for i in pick.round()], norm, device),
@@ -197,8 +118,8 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         gen.set_state(state["generator"].cpu())
         step, train_s = int(state["step"]), float(state["train_s"])
         eval_s = float(state.get("eval_s", 0.0))
-        log_rows = [r for r in _read_log(run_dir) if int(r["step"]) <= step]
-        evals = [e for e in _read_evals(run_dir) if e["step"] <= step]
+        log_rows = [r for r in read_log(run_dir) if int(r["step"]) <= step]
+        evals = [e for e in read_evals(run_dir) if e["step"] <= step]
     box_min = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     box_max = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     classes = tuple(CLASS_NAMES)
@@ -215,7 +136,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             **({} if occupancy is None else {"occupancy": occupancy.occupied}),
             **({} if average is None else {"ema": average.state_dict()}),
         })
-        _write_log(run_dir, log_rows)
+        write_log(run_dir, log_rows)
 
     bar = tqdm(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
                dynamic_ncols=True, disable=None)
@@ -237,7 +158,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
                        "psnr": psnr(result.render.rgb.detach(), pixels.rgb[result.pixel_index]),
                        "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0]}
                 log_rows.append(row)
-                _write_log(run_dir, log_rows)
+                write_log(run_dir, log_rows)
                 bar.set_postfix(loss=f"{row['loss']:.4f}", psnr=f"{row['psnr']:.2f}")
             stop = max_seconds is not None and train_s >= max_seconds
             if step % config.checkpoint_every == 0:
@@ -284,67 +205,6 @@ def _sigterm_as_interrupt():
     if threading.current_thread() is not threading.main_thread():
         return None
     return signal.signal(signal.SIGTERM, _raise_interrupt)
-
-
-def _start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
-                      norm: Normalisation, config: TrainConfig, device: torch.device,
-                      n_train: int) -> None:
-    run_dir.mkdir(parents=True, exist_ok=True)
-    for stale in (CHECKPOINT_NAME, "log.csv", "eval.json"):
-        (run_dir / stale).unlink(missing_ok=True)
-    write_json_atomic(run_dir / "config.json", config_to_dict(config))
-    write_json_atomic(run_dir / "run.json", {
-        "scene_dir": str(scene_dir.resolve()), "scene_name": scene_name(scene_dir),
-        "class_names": list(classes), "background_class": bg,
-        "normalisation": norm.to_json_dict(), "device": str(device),
-        "code_version": code_version(), "torch_version": torch.__version__,
-        "train_frames": n_train,
-    })
-
-
-def _check_resumable(run_dir: Path, config: TrainConfig) -> Normalisation:
-    for name in ("config.json", "run.json", CHECKPOINT_NAME):
-        if not (run_dir / name).is_file():
-            raise ValueError(f"cannot resume: {run_dir / name} does not exist (train without "
-                             "--resume first)")
-    saved = read_run_config(run_dir)
-    if saved != config:
-        raise ValueError(f"cannot resume: {run_dir} was trained with another config; resume "
-                         "with the config in its config.json")
-    try:
-        run = json.loads((run_dir / "run.json").read_text())
-        return Normalisation.from_json_dict(run["normalisation"])
-    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
-            ValueError) as exc:
-        raise ValueError(f"cannot resume: {run_dir / 'run.json'} is damaged ({exc}); train "
-                         "again without --resume") from exc
-
-
-def _write_log(run_dir: Path, rows: list[dict]) -> None:
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=LOG_FIELDS, restval="", extrasaction="ignore")
-    writer.writeheader()
-    writer.writerows(rows)
-    write_text_atomic(run_dir / "log.csv", buf.getvalue())
-
-
-def _read_log(run_dir: Path) -> list[dict]:
-    path = run_dir / "log.csv"
-    if not path.is_file():
-        return []
-    with path.open(newline="") as f:
-        return list(csv.DictReader(f))
-
-
-def _read_evals(run_dir: Path) -> list[dict]:
-    path = run_dir / "eval.json"
-    if not path.is_file():
-        return []
-    try:
-        return list(json.loads(path.read_text())["evaluations"])
-    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError) as exc:
-        raise ValueError(f"cannot resume: {path} is damaged ({exc}); delete it to resume "
-                         "without the evaluation history") from exc
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -403,16 +263,6 @@ def main(argv: list[str] | None = None) -> int:
         return "interrupted before the first checkpoint; run the same command again"
 
     return run_cli("neural3d.train", body, debug=args.debug, interrupted=interrupted)
-
-
-def read_run_config(run_dir: Path) -> TrainConfig:
-    """The config a run folder was trained with (ValueError if its config.json is unreadable)."""
-    path = Path(run_dir) / "config.json"
-    try:
-        return config_from_dict(json.loads(path.read_text()))
-    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError) as exc:
-        raise ValueError(f"{path} is not a valid neural3d config: {exc}; train again without "
-                         "--resume") from exc
 
 
 if __name__ == "__main__":

@@ -23,13 +23,14 @@ import numpy as np
 import pytest
 from shapely.geometry import box as shapely_box
 
-from dataset.classes import NO_FACADE, SemanticClass
-from dataset.footprint import polygon_to_geojson
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.core.footprint import polygon_to_geojson
+from dataset.core.mesh import LabelledMesh, concatenate_meshes
+from dataset.core.truth import Building, BuildingTruth, FacadeTruth
+from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 from dataset.generate import GenerateConfig, generate_preset
-from dataset.mesh import LabelledMesh, concatenate_meshes
-from dataset.scene import read_scene
-from dataset.truth import Building, BuildingTruth, FacadeTruth
-from dataset.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.scenes.scene import read_scene
+from dataset.scenes.scene_writer import generate_scene
 
 BOX_SIZE_M = (20.0, 12.0, 9.0)
 BOX_FLOORS = 3
@@ -155,3 +156,13 @@ def tiny_benchmark(tmp_path_factory: pytest.TempPathFactory) -> Path:
         warnings.simplefilter("ignore", UserWarning)
         generate_preset("tiny", root, TINY_CONFIG, progress=False)
     return root
+
+
+@pytest.fixture(scope="session")
+def clean_scene(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The box building rendered once: 64 px, 8 orbit views, ideal and multi views (read only:
+    copy it before changing it)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return generate_scene(make_box_building(), tmp_path_factory.mktemp("clean"),
+                              GenerateConfig(resolution=64, views=8), seed=0, progress=False)

@@ -10,11 +10,12 @@ from pathlib import Path
 
 import numpy as np
 
-from dataset.camera import Intrinsics, look_at
-from dataset.images import write_depth_m, write_labels, write_rgb
-from dataset.render import Raycaster, RgbConfig, render_ground_truth, render_rgb
-from dataset.scene import Frame, Scene, write_transforms
-from dataset.truth import Building
+from dataset.core.camera import Intrinsics, look_at
+from dataset.core.scene_record import Frame, Scene
+from dataset.core.truth import Building
+from dataset.rendering.render import Raycaster, RgbConfig, render_ground_truth, render_rgb
+from dataset.scenes.images import write_depth_m, write_labels, write_rgb
+from dataset.scenes.scene import write_transforms
 
 
 def write_ring_scene(building: Building, root: Path, *, size_px: int = 40, n_train: int = 24,

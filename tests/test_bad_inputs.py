@@ -4,21 +4,15 @@ Families (each case asserts the exit code, the message and that no partial outpu
 a damaged scene folder (``bad_scene_edits.SCENE_EDITS``) through the baselines and neural3d;
 command-line values and output paths of every CLI; meshes with NaN, absurd or millimetre
 coordinates; malformed JSON of every file the project reads; resources refused before they
-are spent; SIGINT and SIGKILL at random (seeded) points of generate, train and compare,
-followed by a rerun. One 64 px scene of the conftest box is rendered once for the module.
+are spent (interrupted runs: ``test_interrupts.py``). The conftest box's 64 px scene
+(``clean_scene``) is rendered once.
 """
 
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import signal
-import subprocess
-import sys
-import time
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -28,28 +22,18 @@ from conftest import make_box_building
 
 from baselines import wwr2ds, wwr2dss
 from dataset import generate, importer
-from dataset.mesh import LabelledMesh, write_labelled_ply
-from dataset.meta_data import read_meta_data, write_meta_data
-from dataset.results import read_result
-from dataset.scene import read_scene
-from dataset.scene_writer import GenerateConfig, generate_scene
-from dataset.warnings_summary import summarise_warnings
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
+from dataset.core.results import read_result
+from dataset.core.warnings_summary import summarise_warnings
+from dataset.importers.meta_data import read_meta_data, write_meta_data
+from dataset.scenes.scene import read_scene
 from metrics import compare
 from neural3d import extract, train
 from neural3d.config import config_to_dict, preset_config
-from neural3d.normalisation import Normalisation
+from neural3d.field.normalisation import Normalisation
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINES = {"2D-S": wwr2ds.main, "2D-SS": wwr2dss.main}
-
-
-@pytest.fixture(scope="module")
-def clean_scene(tmp_path_factory) -> Path:
-    """The box building rendered once: 64 px, 8 orbit views, ideal and multi views."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return generate_scene(make_box_building(), tmp_path_factory.mktemp("clean"),
-                              GenerateConfig(resolution=64, views=8), seed=0, progress=False)
 
 
 @pytest.fixture
@@ -108,7 +92,7 @@ def test_unknown_class_id_in_a_train_view_stops_training(scene, tmp_path, capsys
 
 def test_degenerate_corners_skip_the_view_with_a_reason(scene, capsys):
     """A facade squashed to one pixel row has no quadrilateral: its facade is missing, said so."""
-    from dataset.images import read_labels, write_labels
+    from dataset.scenes.images import read_labels, write_labels
 
     path = scene / "semantics" / IDEAL
     labels = read_labels(path)
@@ -127,7 +111,7 @@ def test_degenerate_corners_skip_the_view_with_a_reason(scene, capsys):
 
 
 def test_every_view_degenerate_is_an_error_not_a_number(scene, capsys):
-    from dataset.images import write_labels
+    from dataset.scenes.images import write_labels
 
     for path in (scene / "semantics").glob("ideal_*.png"):
         write_labels(path, np.zeros((64, 64)))
@@ -405,98 +389,3 @@ def test_warnings_are_summarised_one_line_per_kind():
     ])
     assert lines == ["box: view images/multi_0003.png (facade 3) skipped: the facade is cut off "
                      "(2 warnings like this)", "box: 1 of 4 facades missing"]
-
-
-# --- SIGINT and SIGKILL at random (seeded) points, then a rerun ---------------------------
-
-def _interrupt(argv: list[str], ready: Path, sig: int, delay_s: float) -> tuple[int, str]:
-    """Start ``python -m argv``, wait until ``ready`` exists, wait ``delay_s``, send ``sig``."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
-    proc = subprocess.Popen([sys.executable, "-m", *map(str, argv)], cwd=ROOT, env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 60
-    while not ready.exists() and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.02)
-    time.sleep(delay_s)
-    if proc.poll() is None:
-        proc.send_signal(sig)
-    _, err = proc.communicate(timeout=120)
-    return proc.returncode, err
-
-
-def _rerun(argv: list[str]) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "OMP_NUM_THREADS": "1"}
-    return subprocess.run([sys.executable, "-m", *map(str, argv)], cwd=ROOT, env=env,
-                          capture_output=True, text=True, timeout=300)
-
-
-def _check_interrupted(code: int, err: str, sig: int, message: str) -> None:
-    """Finished (0), or stopped by the signal: one line for SIGINT, nothing to say for SIGKILL."""
-    assert "Traceback" not in err
-    if code == 0:
-        return
-    if sig == signal.SIGINT:
-        assert code == 130 and message in err
-    else:
-        assert code == -signal.SIGKILL
-
-
-SIGNAL_CASES = [(sig, seed) for sig in (signal.SIGINT, signal.SIGKILL) for seed in (0,)]
-
-
-@pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
-def test_generate_interrupted_then_rerun(sig, seed, tmp_path):
-    out = tmp_path / "out"
-    argv = ["dataset.generate", "--mesh", ROOT / "dataset/examples/example_bim.ply", "--out", out,
-            "--resolution", "48", "--views", "6", "--quiet"]
-    delay = np.random.default_rng([seed, sig]).uniform(0.0, 0.6)
-    code, err = _interrupt(argv, out, sig, delay)
-    _check_interrupted(code, err, sig, "interrupted: finished scenes are kept")
-    if (out / "example_bim").exists():
-        read_scene(out / "example_bim")  # a folder with the final name is always finished
-    assert sig == signal.SIGKILL or not list(out.glob(".*.partial"))  # only SIGKILL leaves one
-    done = _rerun(argv)
-    assert done.returncode == 0, done.stderr
-    read_scene(out / "example_bim")  # complete and valid
-    assert not list(out.glob(".*.partial"))
-
-
-@pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
-def test_train_interrupted_then_resumed(sig, seed, clean_scene, tmp_path):
-    from neural3d.checkpoint import read_checkpoint
-
-    runs = tmp_path / "runs"
-    argv = ["neural3d.train", "--scene", clean_scene, "--preset", "tiny", "--iterations", "20",
-            "--out", runs]
-    delay = np.random.default_rng([seed, sig, 1]).uniform(0.0, 1.0)
-    code, err = _interrupt(argv, runs / clean_scene.name / "log.csv", sig, delay)  # step 10+
-    _check_interrupted(code, err, sig, "interrupted")
-    run = runs / clean_scene.name
-    resumable = (run / "checkpoint.pt").is_file()
-    if sig == signal.SIGINT and code == 130:  # Ctrl-C in training leaves a checkpoint
-        assert ("checkpoint saved" in err) == resumable, err
-    done = _rerun(argv + (["--resume"] if resumable else []))
-    assert done.returncode == 0, done.stderr
-    import torch
-
-    assert int(read_checkpoint(run / "checkpoint.pt", torch.device("cpu"))["step"]) == 20
-    assert (run / "log.csv").read_text().splitlines()[-1].startswith("20,")
-
-
-@pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
-def test_compare_interrupted_then_rerun(sig, seed, clean_scene, tmp_path):
-    bench, results = tmp_path / "bench", tmp_path / "results"
-    for name in ("box_a", "box_b"):
-        shutil.copytree(clean_scene, bench / name)
-    argv = ["metrics.compare", "--data", bench, "--methods", "2D-S,2D-SS", "--results", results,
-            "--out", tmp_path / "cmp"]
-    delay = np.random.default_rng([seed, sig, 2]).uniform(0.0, 0.5)
-    code, err = _interrupt(argv, results, sig, delay)
-    _check_interrupted(code, err, sig, "interrupted: finished results are kept")
-    for path in results.glob("*.json"):
-        read_result(path)  # every result file on disk is whole
-    assert sig == signal.SIGKILL or not list(results.glob(".*.tmp"))
-    done = _rerun(argv)
-    assert done.returncode == 0, done.stderr
-    assert len([read_result(p) for p in results.glob("*.json")]) == 2 * 2 * 2
-    assert (tmp_path / "cmp" / "provenance.json").is_file()

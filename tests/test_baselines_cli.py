@@ -4,8 +4,8 @@ import pytest
 
 from baselines import wwr2ds, wwr2dss
 from baselines.cli import default_results_folder, scene_folders
-from dataset.results import read_result
-from dataset.truth import read_building
+from dataset.core.results import read_result
+from dataset.core.truth import read_building
 
 
 def test_scene_folders_and_default_results_folder(tmp_path):

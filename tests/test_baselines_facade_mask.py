@@ -12,7 +12,7 @@ from baselines.facade_mask import (
     isolate_facade_on_plane,
 )
 from baselines.views import ViewError
-from dataset.camera import Intrinsics, look_at
+from dataset.core.camera import Intrinsics, look_at
 
 L_M, H_M = 12.0, 9.0
 K = Intrinsics.from_fov(256, 256, 60.0)

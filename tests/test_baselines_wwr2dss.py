@@ -21,11 +21,12 @@ from baselines.wwr2dss import (
     rectify_views,
     run_2dss,
 )
-from dataset.camera import Intrinsics, look_at
-from dataset.images import write_depth_m, write_labels, write_rgb
-from dataset.render import render_ground_truth
-from dataset.results import read_result
-from dataset.scene import Frame, read_scene, write_transforms
+from dataset.core.camera import Intrinsics, look_at
+from dataset.core.results import read_result
+from dataset.core.scene_record import Frame
+from dataset.rendering.render import render_ground_truth
+from dataset.scenes.images import write_depth_m, write_labels, write_rgb
+from dataset.scenes.scene import read_scene, write_transforms
 
 L_M, H_M = 12.0, 9.0
 WINDOWS = window_grid(L_M, H_M, 4, 3, 1.6, 1.5)
@@ -55,7 +56,7 @@ def test_oblique_planar_facade_recovers_length_height_and_wwr(azimuth_deg):
 
 
 def test_rendered_box_facade_with_door_seen_obliquely(box_building):
-    # dataset.render on the shared box (facade 1: 20 m x 9 m, facing -y, with a door).
+    # dataset.rendering.render on the shared box (facade 1: 20 m x 9 m, facing -y, with a door).
     truth = box_building.truth.facade(1)
     pose = look_at([12.0, -30.0, 1.6], [0.0, -6.0, 4.5])
     gt = render_ground_truth(box_building.mesh, K, pose)

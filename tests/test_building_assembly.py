@@ -4,15 +4,15 @@ import numpy as np
 import pytest
 from building_checks import check_building
 
-from dataset.building_assembly import (
+from dataset.families.building_assembly import (
     BuildingLayout,
     assemble_building,
     assemble_layout,
     facade_outlines_m,
     facade_truths,
 )
-from dataset.facade_geometry import Opening
-from dataset.prism import ground_face, parapet_roof_faces, prism_walls
+from dataset.families.facade_geometry import Opening
+from dataset.families.prism import ground_face, parapet_roof_faces, prism_walls
 
 RECT = np.array([[-4.0, -3.0], [4.0, -3.0], [4.0, 3.0], [-4.0, 3.0]])
 

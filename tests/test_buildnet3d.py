@@ -1,5 +1,5 @@
-"""dataset.buildnet3d: the Blender generator's output layout, written on the fly from the
-conftest box building rendered with dataset.render, imported back as a project scene."""
+"""dataset.importers.buildnet3d: the Blender generator's output layout, written on the fly from the
+conftest box building rendered with dataset.rendering.render, imported back as a project scene."""
 
 from __future__ import annotations
 
@@ -14,14 +14,14 @@ from conftest import BOX_SIZE_M as BOX
 
 from baselines.facade_mask import PlaneIsolationConfig
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
-from dataset.camera import Intrinsics, look_at, pixel_centres, unproject_depth_to_world
-from dataset.classes import SemanticClass as C
+from dataset.core.camera import Intrinsics, look_at, pixel_centres, unproject_depth_to_world
+from dataset.core.classes import SemanticClass as C
 from dataset.generate import main as generate_main
-from dataset.images import read_depth_m, read_facade_ids
-from dataset.labels import class_mapping
-from dataset.render import render_view
-from dataset.scene import read_scene
-from dataset.scene_validation import read_frame_labels
+from dataset.rendering.render import render_view
+from dataset.scenes.images import read_depth_m, read_facade_ids
+from dataset.scenes.labels import class_mapping
+from dataset.scenes.scene import read_scene
+from dataset.scenes.scene_validation import read_frame_labels
 
 GEN = dict(zip(class_mapping("generator").names, class_mapping("generator").colours))
 COLOUR_OF_OUR_CLASS = {C.BACKGROUND: GEN["background"], C.WALL: GEN["wall"],

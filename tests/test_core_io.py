@@ -7,14 +7,17 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.camera import (
+from dataset.core.camera import (
     Intrinsics,
     look_at,
     project_world_to_image,
     unproject_depth_to_world,
 )
-from dataset.classes import SemanticClass, class_id_from_name
-from dataset.images import (
+from dataset.core.classes import SemanticClass, class_id_from_name
+from dataset.core.mesh import LabelledMesh, area_by_class_m2, read_labelled_ply, write_labelled_ply
+from dataset.core.results import FacadeEstimate, MethodResult, read_result, write_result
+from dataset.core.scene_record import Frame, Scene
+from dataset.scenes.images import (
     read_depth_m,
     read_facade_ids,
     read_labels,
@@ -26,9 +29,7 @@ from dataset.images import (
     write_normals,
     write_rgb,
 )
-from dataset.mesh import LabelledMesh, area_by_class_m2, read_labelled_ply, write_labelled_ply
-from dataset.results import FacadeEstimate, MethodResult, read_result, write_result
-from dataset.scene import Frame, Scene, read_scene, write_transforms
+from dataset.scenes.scene import read_scene, write_transforms
 
 
 def test_project_unproject_round_trip():
@@ -171,7 +172,7 @@ def test_result_file_without_facade_geometry_still_loads(tmp_path):
 def test_footprint_geojson_round_trip():
     from shapely.geometry import Polygon
 
-    from dataset.footprint import geojson_to_polygon, polygon_to_geojson
+    from dataset.core.footprint import geojson_to_polygon, polygon_to_geojson
 
     ring = [(0, 0), (0, 4), (3, 4), (3, 0)]  # clockwise on purpose
     hole = [(1, 1), (2, 1), (2, 2), (1, 2)]
@@ -189,7 +190,7 @@ def test_footprint_geojson_round_trip():
 def test_facade_outlines_are_a_typed_field_and_old_files_still_read(tmp_path):
     from metrics_helpers import make_truth
 
-    from dataset.truth import BuildingTruth, read_building, write_building
+    from dataset.core.truth import BuildingTruth, read_building, write_building
 
     outline = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [4.0, 0.0, 3.0], [0.0, 0.0, 3.0]]
     truth = replace(make_truth("a"), facade_outlines_m={1: [outline]})

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from conftest import make_box_building
 
-from dataset.camera import Intrinsics, unproject_depth_to_world
-from dataset.classes import SemanticClass
+from dataset.core.camera import Intrinsics, unproject_depth_to_world
+from dataset.core.classes import SemanticClass
 from dataset.degrade.depth_noise import noisy_depth_m
 from dataset.degrade.masks import (
     bleed_labels,
@@ -24,9 +24,9 @@ from dataset.degrade.masks import (
 from dataset.degrade.poses import perturb_pose, pose_noise
 from dataset.degrade.scene_copy import RECORD_KEY, degrade_scene
 from dataset.degrade.spec import DEGRADATIONS, DegradeSpec, parse_specs, specs_key
-from dataset.images import read_labels
-from dataset.scene import read_scene
-from dataset.scene_writer import GenerateConfig, generate_scene
+from dataset.scenes.images import read_labels
+from dataset.scenes.scene import read_scene
+from dataset.scenes.scene_writer import GenerateConfig, generate_scene
 
 WALL, WINDOW = int(SemanticClass.WALL), int(SemanticClass.WINDOW)
 SMALL = GenerateConfig(resolution=48, views=6)

@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from dataset.device import resolve_device
+from dataset.core.device import resolve_device
 
 
 def test_cpu_and_errors():

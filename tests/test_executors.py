@@ -20,8 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from dataset.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
-from dataset.results import read_result
+from dataset.core.results import read_result
+from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
 from metrics.compare import main
 from metrics.executors import make_executor
 from metrics.methods import method_specs

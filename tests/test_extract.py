@@ -11,14 +11,14 @@ from metrics_helpers import make_truth
 from sdf_shapes import banded_labels, box_sdf
 from shapely.geometry import box as rectangle
 
-import neural3d.trained
-from dataset.classes import CLASS_NAMES
-from dataset.footprint import geojson_to_polygon
-from dataset.results import read_result, result_filename
-from dataset.truth import FacadeTruth
+import neural3d.field.trained
+from dataset.core.classes import CLASS_NAMES
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.results import read_result, result_filename
+from dataset.core.semantic_ply import read_semantic_ply
+from dataset.core.truth import FacadeTruth
 from metrics.errors import facade_errors
 from neural3d.extract import ExtractConfig, extract_run, main, measure_field
-from neural3d.meshing import read_semantic_ply
 
 BOX_LO, BOX_HI = [-3.0, -2.0, 0.0], [3.0, 2.0, 10.0]  # window band 3-6 m: WWR 0.3
 
@@ -112,7 +112,7 @@ def test_evaluation_matches_the_own_facades_to_the_truth(scene_dir):
 
 
 def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
-    monkeypatch.setattr(neural3d.trained, "load_trained_field",
+    monkeypatch.setattr(neural3d.field.trained, "load_trained_field",
                         lambda run_dir, device: AnalyticField(scene_dir))
     run_dir = tmp_path / "run"
     run_dir.mkdir()

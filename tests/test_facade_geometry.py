@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from dataset.classes import NO_FACADE, SemanticClass
-from dataset.facade_geometry import (
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.families.facade_geometry import (
     MIN_GAP_M,
     Opening,
     WallFrame,
@@ -14,7 +14,7 @@ from dataset.facade_geometry import (
     wall_faces,
     window_grid,
 )
-from dataset.polygon_mesh import triangulate_faces
+from dataset.families.polygon_mesh import triangulate_faces
 
 
 def test_frame_reproduces_its_end_points_exactly_and_faces_right():

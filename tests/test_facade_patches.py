@@ -5,10 +5,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dataset.classes import SemanticClass
-from dataset.facade_patches import facade_patches
-from dataset.mesh import LabelledMesh
-from dataset.truth import Building
+from dataset.core.classes import SemanticClass
+from dataset.core.mesh import LabelledMesh
+from dataset.core.truth import Building
+from dataset.rendering.facade_patches import facade_patches
 
 
 def test_box_facades_have_exact_geometry(box_building):

@@ -1,18 +1,19 @@
-"""neural3d.facade_planes: planes of a meshed box and each triangle's shadow on them."""
+"""neural3d.extraction.facade_planes: planes of a meshed box and each triangle's shadow on them."""
 
 import numpy as np
 import pytest
 from sdf_shapes import banded_labels, box_sdf
 
-from dataset.classes import FACADE_CLASSES
-from neural3d.facade_planes import (
+from dataset.core.classes import FACADE_CLASSES
+from dataset.core.mesh import triangle_normals
+from neural3d.extraction.facade_planes import (
     azimuth_offset,
     circular_mean_deg,
-    face_normals,
     project_onto_facade_planes,
 )
-from neural3d.measure import MeasureConfig, class_area_m2, group_facade_faces
-from neural3d.meshing import extract_mesh, label_vertices
+from neural3d.extraction.measure import class_area_m2, group_facade_faces
+from neural3d.extraction.measure_config import MeasureConfig
+from neural3d.extraction.meshing import extract_mesh, label_vertices
 
 
 def _box_sdf(p):
@@ -39,7 +40,7 @@ def test_box_planes_are_its_four_walls(box_planes):
 
 def test_flat_wall_counts_in_full_and_corners_on_both_walls(box_planes):
     v, f, facade_area, planes = box_planes
-    n = face_normals(v[f])
+    n = triangle_normals(v[f])
     on_wall = (facade_area > 0) & (np.abs(n[:, :2]).max(axis=1) > 0.999)
     # a triangle of a flat wall counts once, with its whole area
     np.testing.assert_allclose(planes.weight[on_wall].sum(axis=1), 1.0, atol=1e-6)
@@ -70,4 +71,4 @@ def test_azimuth_helpers():
     az, offset = azimuth_offset(normals, np.array([[0.0, 2.0], [1.0, 4.0]]), np.array([1.0, 3.0]))
     assert az == pytest.approx(90.0) and offset == pytest.approx(3.5)
     tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 0], [0, 0, 0], [0, 0, 0]]], float)
-    np.testing.assert_allclose(face_normals(tri), [[0, 0, 1], [0, 0, 0]])
+    np.testing.assert_allclose(triangle_normals(tri), [[0, 0, 1], [0, 0, 0]])

@@ -9,14 +9,15 @@ import pytest
 import trimesh
 from metrics_helpers import make_benchmark
 
-from dataset.camera import Intrinsics, look_at
-from dataset.images import write_depth_m, write_labels, write_normals, write_rgb
-from dataset.mesh import LabelledMesh, write_labelled_ply
-from dataset.scene import Frame, Scene, write_transforms
+from dataset.core.camera import Intrinsics, look_at
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
+from dataset.core.scene_record import Frame, Scene
+from dataset.core.semantic_ply import write_semantic_ply
+from dataset.scenes.images import write_depth_m, write_labels, write_normals, write_rgb
+from dataset.scenes.scene import write_transforms
 from figures.make import main
 from figures.meshes import face_labels_from_vertices, render_mesh_views
 from metrics.compare import main as compare_main
-from neural3d.meshing import write_semantic_ply
 
 ALL_FIGURES = ("table1_dataset", "dataset_renders", "2dss_pipeline", "neural3d_meshes",
                "footprint_overlays", "errors_by_family", "wwr_scatter", "iou_per_building")
@@ -113,7 +114,7 @@ def test_missing_inputs_are_skipped_with_a_message(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "skipped dataset_renders: no scene with images" in err
     assert "skipped 2dss_pipeline: no 2D-SS debug images" in err
-    assert "skipped neural3d_meshes: no neural3d mesh yet" in err
+    assert "skipped neural3d_meshes: no reconstructed mesh yet" in err
     assert "skipped footprint_overlays: no estimated footprint" in err
     assert "skipped iou_per_building: no footprint IoU to plot" in err
     assert (tmp_path / "f" / "errors_by_family.png").is_file()
@@ -167,11 +168,11 @@ def test_table1_ranges_per_family(tmp_path):
 
 
 def test_display_encodings():
-    from figures.style import CLASS_RGB, colour_depth, colour_labels, colour_normals
+    from figures.style import CLASS_RGB_ARRAY, colour_depth, colour_labels, colour_normals
 
     labels = np.array([[0, 2], [5, 200]], np.uint8)
     rgb = colour_labels(labels)
-    assert rgb[0, 1].tolist() == CLASS_RGB[2].tolist() and rgb[1, 1].tolist() == [255, 0, 255]
+    assert rgb[0, 1].tolist() == CLASS_RGB_ARRAY[2].tolist() and rgb[1, 1].tolist() == [255, 0, 255]
     normals = np.array([[[0, 0, 0], [1, 0, 0]]], np.float32)
     assert colour_normals(normals).tolist() == [[[0, 0, 0], [255, 128, 128]]]
     depth = colour_depth(np.array([[0.0, 5.0, 10.0]]))

@@ -5,7 +5,7 @@ import tarfile
 
 import pytest
 
-from dataset.folder_pack import pack_folder, unpack_folder
+from dataset.executors.folder_pack import pack_folder, unpack_folder
 
 
 def _make_folder(root):

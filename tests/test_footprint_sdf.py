@@ -1,4 +1,4 @@
-"""neural3d.footprint: zero contour of analytic SDFs on a horizontal plane."""
+"""neural3d.extraction.footprint: zero contour of analytic SDFs on a horizontal plane."""
 
 import numpy as np
 import pytest
@@ -6,8 +6,8 @@ from sdf_shapes import box_sdf, cylinder_sdf, l_prism_sdf
 from shapely.geometry import MultiPolygon, Point, Polygon
 from shapely.geometry import box as rectangle
 
-from dataset.footprint import geojson_to_polygon, polygon_to_geojson
-from neural3d.footprint import footprint_from_sdf
+from dataset.core.footprint import geojson_to_polygon, polygon_to_geojson
+from neural3d.extraction.footprint import footprint_from_sdf
 
 SCENE_LO, SCENE_HI = np.array([-2.0, -2.0, -1.0]), np.array([14.0, 14.0, 10.0])
 
@@ -96,7 +96,7 @@ def test_averaging_planes_cancels_wobbles_of_the_walls():
 
 
 def test_extract_keeps_footprint_planes_below_half_the_box():
-    from neural3d.extract_config import ExtractConfig, footprint_heights_m
+    from neural3d.extraction.extract_config import ExtractConfig, footprint_heights_m
 
     config = ExtractConfig()
     assert footprint_heights_m(np.array([5.0, 5.0, 20.0]), config) == config.footprint_heights_m

@@ -9,18 +9,18 @@ from pathlib import Path
 import pytest
 from conftest import TINY_CONFIG, assert_complete_scene, make_box_building
 
-import dataset.scene_writer as scene_writer
-from dataset.cameras import OrbitConfig
-from dataset.cameras import sample_orbit_views as real_sample_orbit_views
+import dataset.scenes.scene_writer as scene_writer
+from dataset.core.truth import Building
 from dataset.generate import (
     GenerateConfig,
     generate_preset,
     main,
     scene_seed,
 )
-from dataset.scene import read_scene
-from dataset.scene_writer import scene_changes
-from dataset.truth import Building
+from dataset.rendering.orbit_views import OrbitConfig
+from dataset.rendering.orbit_views import sample_orbit_views as real_sample_orbit_views
+from dataset.scenes.scene import read_scene
+from dataset.scenes.scene_writer import scene_changes
 
 SMALL = GenerateConfig(resolution=40, views=6)
 

@@ -1,14 +1,15 @@
-"""dataset.grade and dataset.contact: cutting faces at the ground and where bodies touch."""
+"""dataset.importers.grade and dataset.importers.contact: cutting faces at the ground and where
+bodies touch."""
 
 import numpy as np
 import pytest
 import trimesh
 
-from dataset.classes import SemanticClass
-from dataset.contact import split_touching_faces
-from dataset.grade import edge_balance, split_at_height
-from dataset.mesh import LabelledMesh
-from dataset.mesh_files import merge_vertices
+from dataset.core.classes import SemanticClass
+from dataset.core.mesh import LabelledMesh
+from dataset.importers.contact import split_touching_faces
+from dataset.importers.grade import edge_balance, split_at_height
+from dataset.importers.mesh_files import merge_vertices
 
 
 def _boxes(*bounds) -> LabelledMesh:
@@ -68,8 +69,8 @@ def test_flush_faces_of_overlapping_solids_count_once():
 
 
 def test_walls_overlapping_at_every_corner_give_the_outline_once(tmp_path):
-    from dataset.importer import import_labelled_mesh
-    from dataset.mesh import write_labelled_ply
+    from dataset.core.mesh import write_labelled_ply
+    from dataset.importers.mesh_import import import_labelled_mesh
 
     walls = _boxes(((0, 0, 0), (10, 0.3, 3)), ((0, 7.7, 0), (10, 8, 3)),
                    ((0, 0, 0), (0.3, 8, 3)), ((9.7, 0, 0), (10, 8, 3)), ((0, 0, 3), (10, 8, 3.2)))

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from dataset.grid_prism import (
+from dataset.families.grid_prism import (
     RoofSpec,
     WindowSpec,
     grid_prism_building,

@@ -1,4 +1,5 @@
-"""dataset.ifc_import: IFC houses made on the fly (tests/ifc_models.py) against their areas
+"""dataset.importers.ifc_import: IFC houses made on the fly (tests/ifc_models.py) against their
+areas
 by hand; the same houses as one multi-body PLY; class overrides, skipped elements, CLI.
 
 Tolerances (the issue's acceptance bounds): areas within 1 % of the closed form, WWR within
@@ -12,15 +13,15 @@ import pytest
 from shapely.geometry import Polygon
 
 from dataset import generate
-from dataset.classes import NO_FACADE, SemanticClass
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.mesh import write_labelled_ply
 from dataset.examples.ifc_houses import HOUSES, IfcHouse, box_house
-from dataset.footprint import geojson_to_polygon
-from dataset.ifc_classes import read_class_overrides
-from dataset.ifc_import import import_ifc, read_ifc, warning_lines
-from dataset.import_config import ImportConfig
-from dataset.importer import import_labelled_mesh
-from dataset.mesh import write_labelled_ply
-from dataset.raycast import Raycaster
+from dataset.importers.ifc_classes import read_class_overrides
+from dataset.importers.ifc_import import import_ifc, read_ifc, warning_lines
+from dataset.importers.import_config import ImportConfig
+from dataset.importers.mesh_import import import_labelled_mesh
+from dataset.rendering.raycast import Raycaster
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,9 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
-from dataset.classes import SemanticClass
+from dataset.core.classes import SemanticClass
+from dataset.core.footprint import geojson_to_polygon
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
 from dataset.examples.make_example_bim import (
     DOOR,
     WALL,
@@ -20,9 +22,7 @@ from dataset.examples.make_example_bim import (
     example_bim_boxes,
     write_labelled_obj,
 )
-from dataset.footprint import geojson_to_polygon
-from dataset.importer import ImportConfig, import_labelled_mesh
-from dataset.mesh import LabelledMesh, write_labelled_ply
+from dataset.importers.mesh_import import ImportConfig, import_labelled_mesh
 from dataset.presets import build_building, preset_recipes
 
 REL = 1e-6
@@ -306,7 +306,7 @@ def test_generate_mesh_takes_every_import_option(tmp_path):
     from dataclasses import fields
 
     from dataset.generate import _parse_args
-    from dataset.import_config import import_config_from_args
+    from dataset.importers.import_config import import_config_from_args
 
     args = _parse_args(["--mesh", "m.ply", "--out", str(tmp_path), "--ground-z", "0.5",
                         "--up-axis", "y", "--footprint-height-m", "0.2", "--keep-position",

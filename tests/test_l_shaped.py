@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from building_checks import check_building
 
-from dataset.grid_prism import RoofSpec
-from dataset.l_shaped import (
+from dataset.families.grid_prism import RoofSpec
+from dataset.families.l_shaped import (
     FLOORS_RANGE,
     FOOTPRINT_RANGE_M2,
     HEIGHT_RANGE_M,

@@ -1,4 +1,5 @@
-"""dataset.labels: every method reads a frame's labels in our ids, whatever the scene holds."""
+"""dataset.scenes.labels: every method reads a frame's labels in our ids, whatever the scene
+holds."""
 
 from __future__ import annotations
 
@@ -7,12 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dataset.camera import Intrinsics
-from dataset.classes import SemanticClass
-from dataset.images import write_labels
-from dataset.labels import class_mapping, mapping_for_classes
-from dataset.scene import Frame, Scene
-from dataset.scene_validation import read_frame_labels
+from dataset.core.camera import Intrinsics
+from dataset.core.classes import SemanticClass
+from dataset.core.scene_record import Frame, Scene
+from dataset.scenes.images import write_labels
+from dataset.scenes.labels import class_mapping, mapping_for_classes
+from dataset.scenes.scene_validation import read_frame_labels
 
 
 def _scene(tmp_path, labels, classes):

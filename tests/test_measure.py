@@ -1,17 +1,18 @@
-"""neural3d.measure: class areas, WWR and facade grouping on meshes of analytic shapes."""
+"""neural3d.extraction.measure: class areas, WWR and facade grouping on meshes of analytic
+shapes."""
 
 import numpy as np
 import pytest
 from sdf_shapes import banded_labels, box_sdf, cylinder_sdf, l_prism_sdf
 
-from dataset.classes import SemanticClass
-from neural3d.measure import (
+from dataset.core.classes import SemanticClass
+from neural3d.extraction.measure import (
     MeasureConfig,
     class_area_m2,
     group_facade_faces,
     measure_semantic_mesh,
 )
-from neural3d.meshing import extract_mesh, label_vertices
+from neural3d.extraction.meshing import extract_mesh, label_vertices
 
 WALL, WINDOW, ROOF = int(SemanticClass.WALL), int(SemanticClass.WINDOW), int(SemanticClass.ROOF)
 

@@ -1,10 +1,10 @@
-"""dataset.mesh_files: class names, vertex merging, OBJ parsing."""
+"""dataset.importers.mesh_files: class names, vertex merging, OBJ parsing."""
 
 import numpy as np
 import pytest
 
-from dataset.classes import SemanticClass
-from dataset.mesh_files import class_from_name, merge_vertices, read_labelled_mesh_file
+from dataset.core.classes import SemanticClass
+from dataset.importers.mesh_files import class_from_name, merge_vertices, read_labelled_mesh_file
 
 
 @pytest.mark.parametrize("name, expected", [

@@ -1,20 +1,20 @@
-"""neural3d.meshing: marching cubes of analytic SDFs, vertex semantics and the semantic PLY."""
+"""neural3d.extraction.meshing: marching cubes of analytic SDFs, vertex semantics and the semantic
+PLY."""
 
 import numpy as np
 import pytest
 import trimesh
 from sdf_shapes import box_sdf
 
-from dataset.mesh import triangle_areas_m2
-from neural3d.meshing import (
+from dataset.core.mesh import triangle_areas_m2
+from dataset.core.semantic_ply import read_semantic_ply, write_semantic_ply
+from neural3d.extraction.meshing import (
     color_vertices,
     extract_mesh,
     grid_axes_m,
     label_vertices,
-    read_semantic_ply,
     remove_small_components,
     vertex_normals,
-    write_semantic_ply,
 )
 
 BOX_LO, BOX_HI = np.array([-3.0, -2.0, 0.0]), np.array([3.0, 2.0, 5.0])  # 6 x 4 x 5 m

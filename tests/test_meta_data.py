@@ -1,4 +1,5 @@
-"""dataset.meta_data: meta_data.json round trips, OpenGL <-> OpenCV poses, class remapping."""
+"""dataset.importers.meta_data: meta_data.json round trips, OpenGL <-> OpenCV poses, class
+remapping."""
 
 import json
 from dataclasses import replace
@@ -7,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from dataset.camera import Intrinsics, look_at, project_world_to_image
-from dataset.classes import SemanticClass
-from dataset.meta_data import (
+from dataset.core.camera import Intrinsics, look_at, project_world_to_image
+from dataset.core.classes import SemanticClass
+from dataset.core.scene_record import Frame, Scene
+from dataset.importers.meta_data import (
     BUILDNET3D_LAYOUT,
     SDFSTUDIO_LAYOUT,
     class_mapping,
@@ -19,7 +21,7 @@ from dataset.meta_data import (
     remap_labels,
     write_meta_data,
 )
-from dataset.scene import Frame, Scene, read_scene, write_transforms
+from dataset.scenes.scene import read_scene, write_transforms
 
 K = Intrinsics(40.0, 42.0, 16.5, 12.25, 32, 24)
 
@@ -155,7 +157,7 @@ def test_remap_colour_coded_masks():
 
 
 def test_scene_box_around_the_building_and_partial_boxes_completed(tmp_path):
-    from dataset.importer import import_labelled_mesh
+    from dataset.importers.mesh_import import import_labelled_mesh
 
     example = Path(__file__).resolve().parents[1] / "dataset" / "examples" / "example_bim.ply"
     truth = import_labelled_mesh(example).truth

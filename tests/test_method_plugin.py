@@ -1,58 +1,40 @@
-"""A method from another package, registered through the entry point, runs in metrics.compare."""
+"""A method from another package, registered through the entry point, runs in metrics.compare.
+
+The package is the worked example of docs/adding-a-method.md, read from the page.
+"""
 
 import contextlib
 import io
+import re
 import sys
-import textwrap
+from pathlib import Path
 
-from dataset.method import ENTRY_POINT_GROUP, installed_methods
+from dataset.core.method import ENTRY_POINT_GROUP, installed_methods
 from metrics.compare import main
 from metrics.tables import read_csv_rows
 
-TOY_MODULE = '''
-"""A toy WWR method: window / facade pixels of the semantic masks, nothing else."""
-from dataclasses import dataclass
-
-import numpy as np
-
-from dataset.classes import SemanticClass
-from dataset.images import read_labels
-from dataset.method import Method
-from dataset.results import MethodResult
-from dataset.wwr import wwr_from_areas
+DOC = Path(__file__).resolve().parent.parent / "docs" / "adding-a-method.md"
 
 
-@dataclass(frozen=True)
-class ToyConfig:
-    noise: float = 0.0
-
-
-def run(scene, protocol, config):
-    counts = np.zeros(3)
-    for frame in scene.frames_in(protocol):
-        labels = read_labels(scene.path(frame.semantic_file_path))
-        counts += [(labels == c).sum() for c in
-                   (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR)]
-    wwr = wwr_from_areas(*counts) + config.noise
-    return MethodResult(scene=scene.root.name, method="toy", protocol=protocol, wwr=wwr,
-                        window_area_m2=None, facade_area_m2=None)
-
-
-METHOD = Method(name="toy", inputs=("semantics",), protocols=("ideal", "multi"),
-                config_type=ToyConfig, run=run, packages=("toy_wwr_plugin",))
-'''
+def doc_blocks(language: str) -> list[str]:
+    """The fenced code blocks of ``language`` in docs/adding-a-method.md, in order."""
+    return re.findall(rf"```{language}\n(.*?)```", DOC.read_text(), flags=re.S)
 
 
 def _install_toy_package(root, monkeypatch):
-    """A throwaway distribution on sys.path: a module and its dist-info with the entry point."""
-    (root / "toy_wwr_plugin.py").write_text(TOY_MODULE)
+    """A throwaway distribution on sys.path: the documented module, and a dist-info with the
+    documented entry point."""
+    (root / "toy_wwr_plugin.py").write_text(doc_blocks("python")[0])
+    (table,) = [b for b in doc_blocks("toml") if ENTRY_POINT_GROUP in b]
     info = root / "toy_wwr_plugin-0.1.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: toy-wwr-plugin\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(textwrap.dedent(f"""
-        [{ENTRY_POINT_GROUP}]
-        toy = toy_wwr_plugin:METHOD
-    """))
+    # pyproject's [project.entry-points."GROUP"] table with `name = "module:attr"` lines is
+    # [GROUP] with `name = module:attr` lines in entry_points.txt
+    entries = re.findall(r'^(\S+) = "(\S+)"$', table, flags=re.M)
+    assert entries == [("toy", "toy_wwr_plugin:METHOD")]
+    (info / "entry_points.txt").write_text(
+        f"[{ENTRY_POINT_GROUP}]\n" + "".join(f"{k} = {v}\n" for k, v in entries))
     monkeypatch.syspath_prepend(str(root))
 
 

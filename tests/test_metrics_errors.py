@@ -7,7 +7,7 @@ import pytest
 from metrics_helpers import make_result, make_truth
 from shapely.geometry import MultiPolygon, Point, Polygon, box
 
-from dataset.results import FacadeEstimate
+from dataset.core.results import FacadeEstimate
 from metrics.errors import (
     absolute_percentage_error,
     building_errors,

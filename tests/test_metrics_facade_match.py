@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 from sdf_shapes import banded_labels, cylinder_sdf
 
+from dataset.core.results import FacadeEstimate
+from dataset.core.truth import FacadeTruth
+from dataset.core.wwr import wwr_from_areas
 from dataset.presets import build_building, preset_recipes
-from dataset.results import FacadeEstimate
-from dataset.truth import FacadeTruth
-from dataset.wwr import wwr_from_areas
 from metrics.facade_match import distance_to_outline_m, has_facade_geometry, match_facades
 from neural3d.extract import facade_estimates
-from neural3d.measure import measure_semantic_mesh
-from neural3d.meshing import extract_mesh, label_vertices
+from neural3d.extraction.measure import measure_semantic_mesh
+from neural3d.extraction.meshing import extract_mesh, label_vertices
 
 TOL = 1e-9
 

@@ -5,7 +5,8 @@ from dataclasses import asdict
 import pytest
 
 from metrics.benchmark_cache import DefaultBenchmark
-from metrics.methods import Neural3dBudget, method_specs
+from metrics.methods import method_specs
+from neural3d.method import Neural3dBudget
 
 
 def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
@@ -14,8 +15,9 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     from neural3d.config import preset_config
 
     specs = method_specs(("2D-S", "2D-SS", "neural3d"), ("ideal",), tmp_path,
-                         neural3d=Neural3dBudget(preset="tiny", steps=300, max_minutes=1.5,
-                                                 resolution=96, eval_frames=1))
+                         configs={"neural3d": Neural3dBudget(
+                             preset="tiny", steps=300, max_minutes=1.5, resolution=96,
+                             eval_frames=1)})
     s2ds, s2dss, n3d = specs
     assert (s2ds.protocols, s2ds.config) == (("ideal",), asdict(Wwr2dsConfig()))
     assert s2dss.config == asdict(Wwr2dssConfig())
@@ -27,8 +29,8 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     assert n3d.code == ("dataset", "neural3d") and s2dss.code == ("dataset", "baselines")
     assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
     # the whole extraction config keys the cache, so a result measured otherwise is redone
-    from neural3d.extract_config import ExtractConfig
-    from neural3d.measure import MeasureConfig
+    from neural3d.extraction.extract_config import ExtractConfig
+    from neural3d.extraction.measure_config import MeasureConfig
 
     assert n3d.config["measure"] == asdict(MeasureConfig())
     (default,) = method_specs(("neural3d",), (), tmp_path)

@@ -8,9 +8,9 @@ import json
 
 import pytest
 
+from dataset.core.provenance import make_provenance, provenance_changes
+from dataset.core.results import read_result
 from dataset.degrade.spec import parse_specs
-from dataset.provenance import make_provenance, provenance_changes
-from dataset.results import read_result
 from metrics.compare import main
 from metrics.degraded import CONFIG_KEY, with_degradation
 from metrics.errors import BuildingErrors
@@ -50,7 +50,7 @@ def test_study_rejects_bad_levels() -> None:
     with pytest.raises(ValueError):
         RobustnessStudy(levels=(("mask_miss", (2.0,)),))
     with pytest.raises(ValueError):
-        RobustnessStudy(neural3d_levels="some")
+        RobustnessStudy(heavy_levels="some")
 
 
 def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
@@ -60,7 +60,7 @@ def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
     assert degraded.config == {"a": 1, CONFIG_KEY: record}
     # A clean result is never reused for a degraded run, nor one of another severity.
     def record(config):
-        return make_provenance(config, modules=("dataset.wwr",), inputs={})
+        return make_provenance(config, modules=("dataset.core.wwr",), inputs={})
 
     assert provenance_changes(record({"a": 1}), record(degraded.config))
     assert provenance_changes(record({"a": 1, CONFIG_KEY: [

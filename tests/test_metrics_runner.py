@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 from metrics_helpers import make_result, make_truth
 
-from dataset.results import read_result
-from dataset.truth import write_building
+from dataset.core.results import read_result
+from dataset.core.truth import write_building
 from metrics.runner import MethodSpec, find_scenes, run_missing
 
 

@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from neural3d.checkpoint import read_checkpoint, write_checkpoint
+from neural3d.field.checkpoint import read_checkpoint, write_checkpoint
 
 
 def test_round_trip(tmp_path):

@@ -5,9 +5,14 @@ import pytest
 import torch
 from neural3d_scene import write_ring_scene
 
-from dataset.camera import unproject_depth_to_world
-from dataset.scene import read_scene
-from neural3d.data import background_class, frames_to_pixels, load_frames, scene_normalisation
+from dataset.core.camera import unproject_depth_to_world
+from dataset.scenes.scene import read_scene
+from neural3d.training.data import (
+    background_class,
+    frames_to_pixels,
+    load_frames,
+    scene_normalisation,
+)
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import torch
 
-from neural3d.encoding import GridEncoding, _FlatGather, positional_encoding
+from neural3d.field.encoding import GridEncoding, _FlatGather, positional_encoding
 
 
 def test_positional_encoding_values():

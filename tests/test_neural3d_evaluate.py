@@ -4,9 +4,9 @@ import numpy as np
 import torch
 
 from neural3d.config import preset_config
-from neural3d.data import Pixels
-from neural3d.evaluate import eval_pixel_subset, evaluate
-from neural3d.fields import SemanticSDF
+from neural3d.field.fields import SemanticSDF
+from neural3d.training.data import Pixels
+from neural3d.training.evaluate import eval_pixel_subset, evaluate
 
 
 def test_all_sky_pixels():

@@ -5,7 +5,7 @@ import pytest
 import torch
 
 from neural3d.config import FieldConfig
-from neural3d.fields import SemanticSDF
+from neural3d.field.fields import SemanticSDF
 
 BOX = (np.array([-1.0, -1.0, -1.0]), np.array([1.0, 1.0, 1.0]))
 

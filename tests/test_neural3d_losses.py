@@ -7,8 +7,16 @@ import pytest
 import torch
 
 from neural3d.config import TrainConfig
-from neural3d.losses import depth_l1, eikonal, mask_bce, psnr, rgb_l1, semantic_nll, total_loss
-from neural3d.model import RenderOutput
+from neural3d.rendering.model import RenderOutput
+from neural3d.training.losses import (
+    depth_l1,
+    eikonal,
+    mask_bce,
+    psnr,
+    rgb_l1,
+    semantic_nll,
+    total_loss,
+)
 
 
 def test_closed_forms():

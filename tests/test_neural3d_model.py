@@ -4,8 +4,8 @@ import numpy as np
 import torch
 
 from neural3d.config import preset_config
-from neural3d.fields import SemanticSDF
-from neural3d.model import cos_anneal_ratio, render_rays
+from neural3d.field.fields import SemanticSDF
+from neural3d.rendering.model import cos_anneal_ratio, render_rays
 
 
 def test_render_rays_hits_and_misses():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import torch
 
-from neural3d.normalisation import Normalisation
+from neural3d.field.normalisation import Normalisation
 
 
 def test_round_trip_and_unit_box():

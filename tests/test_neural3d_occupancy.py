@@ -5,9 +5,14 @@ import math
 import pytest
 import torch
 
-from neural3d.occupancy import OccupancyGrid
-from neural3d.rendering import neus_alpha, render_accumulation, render_depth, weights_from_alpha
-from neural3d.sampling import neus_upsample, ray_box_near_far, uniform_samples
+from neural3d.rendering.neus import (
+    neus_alpha,
+    render_accumulation,
+    render_depth,
+    weights_from_alpha,
+)
+from neural3d.rendering.occupancy import OccupancyGrid
+from neural3d.rendering.sampling import neus_upsample, ray_box_near_far, uniform_samples
 
 INV_S = 500.0
 LO, HI = torch.tensor([-1.0, -0.6, -0.5]), torch.tensor([1.0, 0.6, 0.5])  # the scene box

@@ -2,7 +2,7 @@
 
 import torch
 
-from neural3d.rendering import (
+from neural3d.rendering.neus import (
     neus_alpha,
     render_accumulation,
     render_depth,
@@ -10,7 +10,7 @@ from neural3d.rendering import (
     render_semantics,
     weights_from_alpha,
 )
-from neural3d.sampling import neus_upsample, ray_box_near_far, uniform_samples
+from neural3d.rendering.sampling import neus_upsample, ray_box_near_far, uniform_samples
 
 INV_S = 1000.0  # sharp density: the rendered surface sits within ~1/INV_S of the zero level
 

@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from neural3d.sampling import neus_upsample, ray_box_near_far, sample_pdf, uniform_samples
+from neural3d.rendering.sampling import neus_upsample, ray_box_near_far, sample_pdf, uniform_samples
 
 
 def test_ray_box_near_far_closed_form():

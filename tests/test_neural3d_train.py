@@ -10,10 +10,11 @@ import torch
 from conftest import BOX_SIZE_M
 from neural3d_scene import write_ring_scene
 
-from neural3d.checkpoint import read_checkpoint
 from neural3d.config import preset_config
-from neural3d.train import lr_factor, main, train
-from neural3d.trained import load_trained_field
+from neural3d.field.checkpoint import read_checkpoint
+from neural3d.field.trained import load_trained_field
+from neural3d.train import main, train
+from neural3d.training.step import lr_factor
 
 CPU = torch.device("cpu")
 SHORT = replace(preset_config("tiny"), iterations=100, eval_every=50, checkpoint_every=50)
@@ -168,7 +169,7 @@ def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
 
 
 def test_train_step_is_the_only_training_step():
-    """bench/neural3d.py calls neural3d.train.train_step; it has no loss/backward of its own."""
+    """bench/neural3d.py calls neural3d.training.step.train_step; no loss/backward of its own."""
     from pathlib import Path
 
     bench = (Path(__file__).resolve().parent.parent / "bench" / "neural3d.py").read_text()
@@ -214,7 +215,7 @@ def test_training_with_occupancy_grid_refreshes_and_checkpoints_it(scene, tmp_pa
 
 
 def test_update_ema_is_the_exponential_average():
-    from neural3d.train import update_ema
+    from neural3d.training.step import update_ema
 
     average, field = torch.nn.Linear(2, 1), torch.nn.Linear(2, 1)
     with torch.no_grad():

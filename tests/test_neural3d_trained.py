@@ -7,8 +7,8 @@ import torch
 from neural3d_scene import write_ring_scene
 
 from neural3d.config import preset_config
+from neural3d.field.trained import load_trained_field
 from neural3d.train import train
-from neural3d.trained import load_trained_field
 
 CPU = torch.device("cpu")
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from sdf_shapes import box_sdf
 
-from dataset.classes import SemanticClass
-from neural3d.meshing import extract_mesh
-from neural3d.plane_sampling import PlaneExtent, plane_extents, plane_sampled_areas
+from dataset.core.classes import SemanticClass
+from neural3d.extraction.meshing import extract_mesh
+from neural3d.extraction.plane_sampling import PlaneExtent, plane_extents, plane_sampled_areas
 
 LO, HI = np.array([0.0, 0.0, 0.0]), np.array([10.0, 6.0, 8.0])
 # Two windows on the +x wall (y, z ranges in m), recessed 0.2 m: 2 x 1.2 x 1.5 = 3.6 m².

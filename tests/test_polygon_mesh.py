@@ -5,8 +5,8 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon, box
 
-from dataset.classes import SemanticClass
-from dataset.polygon_mesh import (
+from dataset.core.classes import SemanticClass
+from dataset.families.polygon_mesh import (
     PlanarFace,
     extruded_faces,
     face_polygon_2d,

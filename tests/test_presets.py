@@ -10,8 +10,10 @@ from building_checks import check_building, check_closed_bodies, check_no_coplan
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from dataset import l_shaped, realistic, skyscraper
-from dataset.mesh import LabelledMesh, write_labelled_ply
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
+from dataset.core.truth import Building, write_building
+from dataset.families import l_shaped, realistic, skyscraper
+from dataset.families.realistic_params import REALISTIC_MODELS
 from dataset.presets import (
     PRESETS,
     BuildingRecipe,
@@ -20,7 +22,6 @@ from dataset.presets import (
     preset_ranges,
     preset_recipes,
 )
-from dataset.truth import Building, write_building
 
 ROOT = Path(__file__).resolve().parent.parent
 RANGES = {
@@ -80,7 +81,8 @@ def test_files_are_identical_across_processes(tiny_buildings, tmp_path):
     # Another interpreter (fresh hash seeds, fresh import order) writes the same bytes.
     code = (
         "import sys; from pathlib import Path; from dataset.presets import *; "
-        "from dataset.mesh import write_labelled_ply; from dataset.truth import write_building; "
+        "from dataset.core.mesh import write_labelled_ply; "
+        "from dataset.core.truth import write_building; "
         "b = build_building(preset_recipes('tiny')[0]); o = Path(sys.argv[1]); "
         "write_labelled_ply(o / 'mesh.ply', b.mesh); write_building(o / 'building.json', b.truth)"
     )
@@ -97,7 +99,7 @@ def test_paper_preset_has_28_buildings_in_the_family_ranges(paper_truths):
     assert [r.family for r in recipes].count("skyscraper") == 12
     assert [r.family for r in recipes].count("l_shaped") == 12
     assert sorted(r.model for r in recipes if r.family == "realistic") == sorted(
-        realistic.REALISTIC_MODELS)
+        REALISTIC_MODELS)
     for truth in paper_truths:
         floors, area, height, wwr = RANGES[truth.type]
         assert floors[0] <= truth.floors <= floors[1], truth.id
@@ -112,7 +114,7 @@ def test_paper_buildings_agree_with_their_meshes(paper_buildings):
 
 
 @settings(max_examples=5, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), model=st.sampled_from(realistic.REALISTIC_MODELS))
+@given(seed=st.integers(0, 2**32 - 1), model=st.sampled_from(REALISTIC_MODELS))
 def test_any_seed_gives_a_building_that_agrees_with_its_mesh(seed, model):
     # 450 seeds per family passed offline; here a few random ones each run.
     for family in ("skyscraper", "l_shaped", "realistic"):

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.classes import SemanticClass
-from dataset.facade_geometry import wall_faces
-from dataset.polygon_mesh import triangulate_faces
-from dataset.prism import (
+from dataset.core.classes import SemanticClass
+from dataset.families.facade_geometry import wall_faces
+from dataset.families.polygon_mesh import triangulate_faces
+from dataset.families.prism import (
     edge_frames,
     gable_roof_faces,
     gable_roof_shell_faces,

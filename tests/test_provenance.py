@@ -8,14 +8,14 @@ from pathlib import Path
 import pytest
 from metrics_helpers import make_result, make_truth
 
-from dataset.provenance import (
+from dataset.core.provenance import (
     Provenance,
     code_fingerprint,
     make_provenance,
     provenance_changes,
 )
-from dataset.results import read_result, write_result
-from dataset.truth import write_building
+from dataset.core.results import read_result, write_result
+from dataset.core.truth import write_building
 from metrics.aggregate import aggregate_by_family
 from metrics.compare import main
 from metrics.errors import building_errors
@@ -33,14 +33,14 @@ def run(result, scene_dir, protocol):
 
 
 def test_record_round_trip_and_changes_in_words():
-    a = make_provenance({"k": 1, "nested": {"x": (1, 2)}}, modules=("dataset.wwr",),
+    a = make_provenance({"k": 1, "nested": {"x": (1, 2)}}, modules=("dataset.core.wwr",),
                         inputs={"scene": "abc"})
     assert Provenance.from_json_dict(a.to_json_dict()) == a
     assert provenance_changes(a, a) == []
     b = replace(a, config={"k": 2, "nested": {"x": [1, 3]}}, inputs={"scene": "def"},
-                code={"dataset.wwr": "0" * 16}, environment={**a.environment, "numpy": "0.1"})
+                code={"dataset.core.wwr": "0" * 16}, environment={**a.environment, "numpy": "0.1"})
     said = [str(c) for c in provenance_changes(a, b)]
-    assert said == ["code of dataset.wwr changed", "inputs changed (scene re-rendered)",
+    assert said == ["code of dataset.core.wwr changed", "inputs changed (scene re-rendered)",
                     "config changed: k 1 -> 2, nested.x [1, 2] -> [1, 3]",
                     f"numpy {a.environment['numpy']} -> 0.1"]
     assert [c.part for c in provenance_changes(None, a)] == ["record"]

@@ -6,8 +6,8 @@ import warnings
 import pytest
 from conftest import TINY_CONFIG
 
+from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig
 from dataset.generate import generate_preset
-from dataset.ray_tasks import LOCAL_ONLY_ENV, RayConfig
 
 # Before Ray is first imported (it reads its settings then): no usage reports, loopback only.
 os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")

@@ -1,9 +1,10 @@
-"""dataset.ray_tasks without a cluster: checked configs, fast failure on a dead address, and
+"""dataset.executors.ray_tasks without a cluster: checked configs, fast failure on a dead address,
+and
 tasks that no node could run refused up front."""
 
 import pytest
 
-from dataset.ray_tasks import RayConfig, TaskResources, _check_fits, ray_session
+from dataset.executors.ray_tasks import RayConfig, TaskResources, _check_fits, ray_session
 
 
 def test_configs_are_checked():

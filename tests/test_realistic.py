@@ -4,16 +4,19 @@ import numpy as np
 import pytest
 from building_checks import check_building
 
-from dataset.realistic import (
+from dataset.families.realistic import (
     FLOORS_RANGE,
     FOOTPRINT_RANGE_M2,
     HEIGHT_RANGE_M,
-    REALISTIC_MODELS,
     WWR_RANGE,
+    make_realistic,
+    realistic_layout,
+    sample_realistic_params,
+)
+from dataset.families.realistic_params import (
+    REALISTIC_MODELS,
     RealisticParams,
     default_realistic_params,
-    make_realistic,
-    sample_realistic_params,
 )
 
 
@@ -56,4 +59,4 @@ def test_bad_parameters_raise_helpful_errors():
     with pytest.raises(ValueError, match="width_m must be > 0"):
         RealisticParams("rounded", width_m=-2.0)
     with pytest.raises(ValueError, match="do not fit|does not fit"):
-        RealisticParams("house", window_width_m=4.0)
+        realistic_layout(RealisticParams("house", window_width_m=4.0))

@@ -4,17 +4,18 @@ import numpy as np
 import pytest
 from building_checks import check_closed_bodies
 
-from dataset.classes import NO_FACADE, SemanticClass
-from dataset.facade_geometry import WallFrame
-from dataset.polygon_mesh import triangulate_faces
-from dataset.realistic import RealisticParams, default_realistic_params, make_realistic
-from dataset.realistic_balcony import (
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.families.facade_geometry import WallFrame
+from dataset.families.polygon_mesh import triangulate_faces
+from dataset.families.realistic import make_realistic
+from dataset.families.realistic_balcony import (
     RAILING_GAP_M,
     RAILING_INSET_M,
     RAILING_THICKNESS_M,
     SLAB_THICKNESS_M,
     balcony_faces,
 )
+from dataset.families.realistic_params import RealisticParams, default_realistic_params
 
 
 def test_balcony_parts_have_closed_form_areas():
@@ -49,4 +50,4 @@ def test_railings_are_separate_bodies_and_contacts_leave_the_facade(model, bodie
 
 def test_balcony_models_need_two_floors():
     with pytest.raises(ValueError, match="floors >= 2"):
-        RealisticParams("balcony_a", 14.0, 10.0, 1, 3.0, 1.0)
+        make_realistic(RealisticParams("balcony_a", 14.0, 10.0, 1, 3.0, 1.0))

@@ -4,14 +4,15 @@ import numpy as np
 import pytest
 from building_checks import check_closed_bodies
 
-from dataset.classes import SemanticClass
-from dataset.realistic import RealisticParams, make_realistic
-from dataset.realistic_house import (
+from dataset.core.classes import SemanticClass
+from dataset.families.realistic import make_realistic
+from dataset.families.realistic_house import (
     CHIMNEY_ABOVE_RIDGE_M,
     ROOF_SHELL_GAP_M,
     ROOF_SHELL_THICKNESS_M,
     house_layout,
 )
+from dataset.families.realistic_params import RealisticParams
 
 
 def test_house_facades_and_roof_are_closed_form():

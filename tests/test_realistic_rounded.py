@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from dataset.realistic import RealisticParams, make_realistic
-from dataset.realistic_rounded import CURVED_FACADE_ID, rounded_footprint
+from dataset.families.realistic import make_realistic
+from dataset.families.realistic_params import RealisticParams
+from dataset.families.realistic_rounded import CURVED_FACADE_ID, rounded_footprint
 
 
 def test_curved_facade_width_and_footprint_are_closed_form():

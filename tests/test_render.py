@@ -6,11 +6,23 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.camera import Intrinsics, look_at, pixel_centres, rays_world, unproject_depth_to_world
-from dataset.classes import SemanticClass
-from dataset.mesh import LabelledMesh, concatenate_meshes
-from dataset.render import Raycaster, RgbConfig, render_ground_truth, render_rgb, render_view
-from dataset.shading import sample_look
+from dataset.core.camera import (
+    Intrinsics,
+    look_at,
+    pixel_centres,
+    rays_world,
+    unproject_depth_to_world,
+)
+from dataset.core.classes import SemanticClass
+from dataset.core.mesh import LabelledMesh, concatenate_meshes
+from dataset.rendering.render import (
+    Raycaster,
+    RgbConfig,
+    render_ground_truth,
+    render_rgb,
+    render_view,
+)
+from dataset.rendering.shading import sample_look
 
 K = Intrinsics.from_fov(160, 120, 60.0)
 # Oblique view of the box's -y and -x facades and its roof (generic: no pixel ray

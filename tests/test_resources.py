@@ -1,8 +1,8 @@
-"""dataset.resources: estimates compared with given memory/disk figures (closed form)."""
+"""dataset.core.resources: estimates compared with given memory/disk figures (closed form)."""
 
 import pytest
 
-from dataset.resources import (
+from dataset.core.resources import (
     RENDER_BYTES_PER_RAY,
     available_memory_bytes,
     check_disk,

@@ -1,12 +1,12 @@
-"""dataset.section: footprints of hollow, disjoint and courtyard solids."""
+"""dataset.rendering.section: footprints of hollow, disjoint and courtyard solids."""
 
 import numpy as np
 import pytest
 import trimesh
 from shapely.geometry import Polygon
 
-from dataset.raycast import Raycaster
-from dataset.section import cross_section_footprint
+from dataset.rendering.raycast import Raycaster
+from dataset.rendering.section import cross_section_footprint
 
 
 def _footprint(mesh, z):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from dataset.shading import (
+from dataset.rendering.shading import (
     RgbConfig,
     environment_radiance,
     sample_look,

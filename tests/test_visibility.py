@@ -1,11 +1,11 @@
-"""dataset.visibility: ray directions, escape fractions on convex and nested boxes."""
+"""dataset.rendering.visibility: ray directions, escape fractions on convex and nested boxes."""
 
 import numpy as np
 import pytest
 import trimesh
 
-from dataset.raycast import Raycaster
-from dataset.visibility import MIN_RAY_COSINE, escape_fractions, hemisphere_directions
+from dataset.rendering.raycast import Raycaster
+from dataset.rendering.visibility import MIN_RAY_COSINE, escape_fractions, hemisphere_directions
 
 
 def _normals(tri):

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from dataset.worker_pool import worker_pool
+from dataset.executors.worker_pool import worker_pool
 
 
 def test_pool_maps_in_order_and_propagates_errors():

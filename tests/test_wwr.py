@@ -1,9 +1,9 @@
-"""The project's one WWR definition (dataset.wwr): window / (wall + window + door)."""
+"""The project's one WWR definition (dataset.core.wwr): window / (wall + window + door)."""
 
 import numpy as np
 import pytest
 
-from dataset.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 
 
 def test_gross_facade_area_is_wall_plus_window_plus_door():

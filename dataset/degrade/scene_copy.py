@@ -18,7 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from dataset.atomic import atomic_directory
+from dataset.core.atomic import atomic_directory
+from dataset.core.mesh import read_labelled_ply
+from dataset.core.scene_record import Frame, Scene
 from dataset.degrade.depth_noise import noisy_depth_m
 from dataset.degrade.masks import (
     bleed_labels,
@@ -31,7 +33,7 @@ from dataset.degrade.masks import (
 from dataset.degrade.occluders import place_occluders, render_occluders
 from dataset.degrade.poses import pose_noise
 from dataset.degrade.spec import DegradeSpec
-from dataset.images import (
+from dataset.scenes.images import (
     read_depth_m,
     read_labels,
     read_normals,
@@ -41,8 +43,7 @@ from dataset.images import (
     write_normals,
     write_rgb,
 )
-from dataset.mesh import read_labelled_ply
-from dataset.scene import Frame, Scene, read_scene, write_transforms
+from dataset.scenes.scene import read_scene, write_transforms
 
 RECORD_KEY = "degradation"
 _MASK_FNS = {

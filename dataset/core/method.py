@@ -1,0 +1,122 @@
+"""The method interface: what a method declares, and how external packages register one.
+
+A :class:`Method` has a name, the inputs it reads, the protocols it runs on,
+the resources it needs, its config type and ``run(scene, protocol, config) ->
+MethodResult``. 2D-S and 2D-SS are declared in :mod:`baselines.methods`,
+neural3d in :mod:`neural3d.method`; ``metrics`` runs every method through this
+record (``metrics.methods``) and knows no method by name.
+
+Another package adds a method without touching this repository by exposing a
+:class:`Method` (or a zero-argument callable returning one) under the entry
+point group ``envelope_bench.methods``, e.g. in its ``pyproject.toml``::
+
+    [project.entry-points."envelope_bench.methods"]
+    my-wwr = "my_package.bench:METHOD"
+
+``python -m metrics.compare --list-methods`` lists what is installed.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from importlib.metadata import entry_points
+from typing import Any, Literal
+
+from dataset.core.protocols import Protocol
+from dataset.core.results import MethodResult
+
+ENTRY_POINT_GROUP = "envelope_bench.methods"
+Input = Literal["rgb", "semantics", "depth", "poses"]
+Resource = Literal["cpu", "gpu"]
+RunMethod = Callable[..., MethodResult]
+"""``run(scene, protocol, config) -> MethodResult`` for one scene; may raise. A method with an
+``artefacts`` folder is called ``run(scene, protocol, config, artefacts_dir=FOLDER)`` and writes
+its folder for the scene (named by the scene) into ``FOLDER``."""
+
+
+@dataclass(frozen=True)
+class Method:
+    """A benchmark method.
+
+    ``inputs``: what it reads from a scene (never the truth). ``protocols``:
+    the view protocols it runs on (``dataset.core.protocols``). ``resources``:
+    ``"gpu"`` if it needs one. ``config_type``: a frozen dataclass whose default
+    instance is the config it runs with (its fields go into the result's
+    provenance). ``packages``: importable packages whose source its results
+    depend on, besides ``dataset`` (a change there recomputes its results);
+    ``libraries``: distributions whose versions matter. ``has_footprint``:
+    whether it estimates a footprint (it is then listed in Table 3).
+
+    Optional, for methods that need more: ``record_config(config)``: the config
+    as its results record it (default: the dataclass's fields);
+    ``reserve(config)``: ``(cpus, gpus)`` one run reserves on a cluster node
+    (default: 1 CPU, and 1 GPU if ``resources`` is ``"gpu"``); ``artefacts``: the
+    folder under the results folder where it keeps one folder per scene (see
+    :data:`RunMethod`); ``mesh_file``: a semantic mesh inside that folder
+    (a PLY with per-vertex class ids), drawn by the figures and the HTML report;
+    ``heavy``: a robustness study runs it only at each degradation's highest
+    severity unless asked otherwise; ``debug_images(scene, protocol, config,
+    folder)``: writes its pipeline images of one scene into ``folder`` (the
+    comparison keeps one facade's for the figures and the report).
+    """
+
+    name: str
+    inputs: tuple[Input, ...]
+    protocols: tuple[Protocol, ...]
+    config_type: type
+    run: RunMethod
+    resources: Resource = "cpu"
+    has_footprint: bool = False
+    packages: tuple[str, ...] = ()
+    libraries: tuple[str, ...] = ("numpy",)
+    description: str = ""
+    record_config: Callable[[Any], dict[str, Any]] | None = None
+    reserve: Callable[[Any], tuple[float, float]] | None = None
+    artefacts: str | None = None
+    mesh_file: str | None = None
+    heavy: bool = False
+    debug_images: Callable[..., None] | None = None
+
+    def config_record(self, config: Any) -> dict[str, Any]:
+        """``config`` as this method's results record it."""
+        if self.record_config is not None:
+            return self.record_config(config)
+        return asdict(config) if hasattr(config, "__dataclass_fields__") else dict(config)
+
+    def cpus_gpus(self, config: Any) -> tuple[float, float]:
+        """What one run with ``config`` reserves on a cluster node: (CPUs, GPUs)."""
+        if self.reserve is not None:
+            return self.reserve(config)
+        return 1.0, 1.0 if self.resources == "gpu" else 0.0
+
+    def __post_init__(self) -> None:
+        if not self.name or "__" in self.name or "/" in self.name:
+            raise ValueError(f"method name {self.name!r} must be non-empty, without '__' or '/'")
+        if not self.protocols:
+            raise ValueError(f"method {self.name} runs on no protocol")
+        if self.mesh_file is not None and self.artefacts is None:
+            raise ValueError(f"method {self.name}: a mesh_file needs an artefacts folder")
+
+
+def installed_methods(warn: Callable[[str], None] | None = None) -> dict[str, Method]:
+    """Methods registered under ``envelope_bench.methods``, by name.
+
+    An entry point that fails to load or is not a :class:`Method` is skipped
+    with a line to ``warn`` (stderr by default); the others load.
+    """
+    warn = warn or (lambda line: print(line, file=sys.stderr))
+    found: dict[str, Method] = {}
+    for ep in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda e: e.name):
+        try:
+            obj = ep.load()
+            method = obj if isinstance(obj, Method) else obj()
+        except Exception as exc:  # a broken plugin must not stop the benchmark
+            warn(f"method plugin {ep.name} ({ep.value}) skipped: {type(exc).__name__}: {exc}")
+            continue
+        if not isinstance(method, Method):
+            warn(f"method plugin {ep.name} ({ep.value}) skipped: not a dataset.core.method.Method")
+            continue
+        found.setdefault(method.name, method)
+    return found

@@ -1,0 +1,140 @@
+"""Exact ground truth of one building: ``building.json`` (DESIGN.md).
+
+Areas follow one convention everywhere: a window's (or door's) area is its
+opening in the facade plane; the reveal (the shallow recess around it) is not
+facade area. Gross facade area = wall + window + door; WWR comes from
+:func:`dataset.core.wwr.wwr_from_areas`, the project's one definition.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from dataset.core.atomic import write_json_atomic
+from dataset.core.mesh import LabelledMesh
+
+BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
+BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
+
+
+@dataclass(frozen=True)
+class FacadeTruth:
+    """One facade: a wall plane (or a curved wall) facing one way.
+
+    ``normal`` is the outward unit vector in the world frame (for a curved
+    facade, the mean outward direction); ``width_m`` is measured along the wall
+    (arc length for a curved one).
+    """
+
+    id: int
+    normal: tuple[float, float, float]
+    width_m: float
+    height_m: float
+    window_area_m2: float
+    wall_area_m2: float
+    door_area_m2: float
+    facade_area_m2: float
+    wwr: float
+    curved: bool = False
+
+
+@dataclass(frozen=True)
+class BuildingTruth:
+    """Whole-building ground truth; areas in m², lengths in m, world x/y for the footprint.
+
+    ``facade_outlines_m``: per facade id, the world-frame outline of each of its
+    walls, (n, 3) corners in metres counter-clockwise seen from outside (a
+    planar facade has one, a faceted curved facade one per facet); empty when
+    unknown (e.g. imported meshes). Evaluation matches a method's own facades
+    to the truth's by them. Older files kept them in ``extra["facade_outlines_m"]``:
+    they are moved here when read (and when built that way).
+    """
+
+    id: str
+    type: BuildingType
+    floors: int
+    height_m: float
+    window_area_m2: float
+    facade_area_m2: float
+    wall_area_m2: float
+    door_area_m2: float
+    wwr: float
+    footprint: dict[str, Any]  # GeoJSON Polygon, world x/y metres
+    footprint_area_m2: float
+    facades: tuple[FacadeTruth, ...]
+    name: str = ""
+    seed: int | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+    facade_outlines_m: dict[int, tuple[tuple[tuple[float, float, float], ...], ...]] = field(
+        default_factory=dict)
+
+    def __post_init__(self) -> None:
+        outlines = self.facade_outlines_m
+        if not outlines and "facade_outlines_m" in self.extra:
+            outlines = self.extra["facade_outlines_m"]
+            object.__setattr__(self, "extra", {k: v for k, v in self.extra.items()
+                                               if k != "facade_outlines_m"})
+        object.__setattr__(self, "facade_outlines_m", {
+            int(fid): tuple(tuple(tuple(float(x) for x in corner) for corner in outline)
+                            for outline in walls)
+            for fid, walls in outlines.items()
+        })
+
+    def facade(self, facade_id: int) -> FacadeTruth:
+        """The facade with id ``facade_id``."""
+        for f in self.facades:
+            if f.id == facade_id:
+                return f
+        raise KeyError(f"building {self.id} has no facade {facade_id}")
+
+    def to_json_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["facades"] = [asdict(f) for f in self.facades]
+        for f in d["facades"]:
+            f["normal"] = list(f["normal"])
+        d["facade_outlines_m"] = {
+            str(fid): [[list(corner) for corner in outline] for outline in walls]
+            for fid, walls in sorted(self.facade_outlines_m.items())
+        }
+        return d
+
+    @staticmethod
+    def from_json_dict(d: dict[str, Any]) -> BuildingTruth:
+        facades = tuple(
+            FacadeTruth(**{**f, "normal": tuple(float(x) for x in f["normal"])})
+            for f in d["facades"]
+        )
+        return BuildingTruth(**{**d, "facades": facades})
+
+
+@dataclass(frozen=True)
+class Building:
+    """A building as the generator (or the importer) makes it: labelled mesh + exact truth."""
+
+    mesh: LabelledMesh
+    truth: BuildingTruth
+
+
+def write_building(path: str | Path, truth: BuildingTruth) -> None:
+    """Write ``building.json`` atomically (deterministic bytes for equal input)."""
+    write_json_atomic(path, truth.to_json_dict())
+
+
+def read_building(path: str | Path) -> BuildingTruth:
+    """Read ``building.json``.
+
+    Raises
+    ------
+    ValueError
+        If the file is missing or lacks a field of DESIGN.md's schema.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"ground truth file {path} does not exist")
+    try:
+        return BuildingTruth.from_json_dict(json.loads(path.read_text()))
+    except (json.JSONDecodeError, TypeError, KeyError) as exc:
+        raise ValueError(f"{path} is not a valid building.json: {exc}") from exc

@@ -1,0 +1,310 @@
+"""Import the BuildNet3D-dataset Blender generator's output as project scenes.
+
+``python -m dataset.generate --buildnet3d PATH --out DIR`` calls :func:`import_buildnet3d`.
+PATH is the generator's output root (``images/building{i}/meta_data.json`` for every
+building) or one ``images/building{i}`` folder. One scene folder ``DIR/building{i}`` per
+building; the facts of the format and where they come from are in docs/importing.md.
+
+- labels: colour masks ``masks/building{i}/building_{i}_{v}_mask0001.png``, colours
+  resolved through ``segmentation_data.json`` and the generator palette
+  (:func:`dataset.scenes.labels.class_mapping`); an unknown colour is an error;
+- depth: Radiance HDR z-depth in metres ``depths/…_depth0001.hdr`` (background 1e10),
+  read with OpenCV, written as our 16-bit PNG;
+- poses: ``camtoworld`` is Blender's ``matrix_world`` (OpenGL camera, z-up world metres),
+  our convention already, despite ``camera_model: OPEN_CV``;
+- facade ids per pixel: from the per-wall ground truth (``wwr_information``) with the
+  depth: a wall/window pixel belongs to the wall whose plane and extent it lies on;
+- split: every view is ``train``; for each wall the view that sees most of it head-on is
+  also its ``ideal`` view and the next best up to five are its ``multi`` views;
+- ``building.json`` from ``wwr_information`` (window area = the wall's ``wwr`` times its
+  opaque ``area``; the generator's WWR divides by the opaque wall, ours by the gross facade).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+from shapely.geometry import LineString
+from shapely.ops import polygonize, unary_union
+
+from dataset.core.camera import Intrinsics, pixel_centres, unproject_depth_to_world
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.core.footprint import polygon_to_geojson
+from dataset.core.scene_record import Frame, Scene
+from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
+from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.scenes.images import (
+    DEPTH_MAX_UNITS,
+    read_rgb,
+    write_depth_m,
+    write_facade_ids,
+    write_labels,
+    write_rgb,
+)
+from dataset.scenes.labels import class_mapping, read_remapped_labels
+from dataset.scenes.scene import write_transforms
+
+HDR_BACKGROUND_M = 1e9
+"""HDR depths at or beyond this are background (the generator writes 1e10)."""
+PLANE_TOLERANCE_M = 0.3
+"""A pixel lies on a wall if its point is this close to the wall's plane and extent
+(windows sit in shallow reveals; the HDR depth is good to about 0.4 % of the depth)."""
+MULTI_VIEWS = 5
+
+
+def find_buildings(path: str | Path) -> list[tuple[Path, int]]:
+    """(dataset root, building index) of every building under ``path``.
+
+    Raises
+    ------
+    ValueError
+        ``path`` holds neither layout of the generator.
+    """
+    path = Path(path)
+    match = re.fullmatch(r"building(\d+)", path.name)
+    if match and (path / "meta_data.json").is_file():
+        return [(path.parent.parent, int(match.group(1)))]
+    found = sorted(
+        (int(m.group(1)), p.parent)
+        for p in (path / "images").glob("building*/meta_data.json")
+        if (m := re.fullmatch(r"building(\d+)", p.parent.name))
+    )
+    if not found:
+        hint = (" (it looks like the BlenderProc layout, which this importer does not read "
+                "yet)" if (path / "semantic").is_dir() or (path / "semantics").is_dir() else "")
+        raise ValueError(
+            f"{path} holds no BuildNet3D-dataset building: expected images/building<i>/"
+            f"meta_data.json under it, or an images/building<i> folder{hint}"
+        )
+    return [(path, index) for index, _ in found]
+
+
+def import_buildnet3d(path: str | Path, out_root: str | Path, *,
+                      overwrite: bool = False) -> list[Path]:
+    """Import every building under ``path`` into ``out_root``; return the scene folders.
+
+    Each scene is written into a temporary folder and renamed when finished, so a scene
+    folder with its final name is always complete. An existing scene is kept unless
+    ``overwrite``.
+    """
+    out_root = Path(out_root)
+    out_root.mkdir(parents=True, exist_ok=True)
+    scenes = []
+    for root, index in find_buildings(path):
+        final = out_root / f"building{index}"
+        if final.exists() and not overwrite:
+            scenes.append(final)
+            continue
+        tmp = out_root / f".building{index}.partial"
+        shutil.rmtree(tmp, ignore_errors=True)
+        try:
+            import_building(root, index, tmp)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        shutil.rmtree(final, ignore_errors=True)
+        tmp.rename(final)
+        scenes.append(final)
+    return scenes
+
+
+def import_building(root: Path, index: int, out_dir: Path) -> Scene:
+    """Write building ``index`` of the generator output ``root`` as a scene in ``out_dir``."""
+    images = root / "images" / f"building{index}"
+    meta = _read_json(images / "meta_data.json")
+    _check_segmentation_colours(_read_json(images / "segmentation_data.json"),
+                                images / "segmentation_data.json")
+    walls = read_walls(root / "wwr_information" / f"building{index}_wwr.json")
+    for sub in ("images", "semantics", "depth", "instances"):
+        (out_dir / sub).mkdir(parents=True, exist_ok=True)
+    width, height = int(meta["width"]), int(meta["height"])
+    frames: list[Frame] = []
+    pixels_per_wall: list[np.ndarray] = []
+    loaded = []
+    for fr in meta["frames"]:
+        stem = Path(fr["rgb_path"]).stem  # building_{i}_{v}
+        k = np.asarray(fr["intrinsics"], dtype=np.float64)
+        intr = Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]),
+                          width, height)
+        pose = np.asarray(fr["camtoworld"], dtype=np.float64)
+        labels = read_remapped_labels(root / "masks" / f"building{index}" /
+                                      f"{stem}_mask0001.png", class_mapping("generator"))
+        depth = read_hdr_depth_m(root / "depths" / f"building{index}" / f"{stem}_depth0001.hdr")
+        fids = facade_ids_from_walls(labels, depth, intr, pose, walls)
+        loaded.append((stem, intr, pose, labels, depth, fids))
+        pixels_per_wall.append(np.array([
+            np.count_nonzero(fids == w + 1) * max(0.0, float(pose[:3, 2] @ wall["normal"]))
+            for w, wall in enumerate(walls)]))
+    unit = _depth_unit_m(max(float(d.max(initial=0.0)) for *_, d, _ in loaded))
+    for stem, intr, pose, labels, depth, fids in loaded:
+        write_rgb(out_dir / "images" / f"{stem}.png",
+                  read_rgb(images / f"{stem}.png"))
+        write_labels(out_dir / "semantics" / f"{stem}.png", labels)
+        write_depth_m(out_dir / "depth" / f"{stem}.png", depth, unit)
+        write_facade_ids(out_dir / "instances" / f"{stem}.png", fids)
+        frames.append(_frame(stem, intr, pose, "train", None))
+    score = np.array(pixels_per_wall)  # (views, walls)
+    for w in range(len(walls)):
+        order = [v for v in np.argsort(-score[:, w], kind="stable") if score[v, w] > 0]
+        for rank, v in enumerate(order[: 1 + MULTI_VIEWS]):
+            stem, intr, pose, *_ = loaded[v]
+            frames.append(_frame(stem, intr, pose, "ideal" if rank == 0 else "multi", w + 1))
+    scene = Scene(root=out_dir, frames=tuple(frames), depth_unit_scale_factor=unit,
+                  extra={"source": "BuildNet3D-dataset", "source_building": index})
+    write_transforms(out_dir, scene)
+    write_building(out_dir / "building.json", building_truth(walls, f"building{index}"))
+    return scene
+
+
+def read_walls(path: Path) -> list[dict[str, Any]]:
+    """The per-wall ground truth of a ``building{i}_wwr.json``, outward normals added.
+
+    Each wall: ``center`` (3,), ``normal`` (3,) outward unit, ``domain`` (3, 2) min/max
+    x/y/z, ``wwr`` (window / opaque wall), ``area`` (opaque wall, m²); plus ``overall_wwr``.
+    """
+    data = _read_json(path)
+    walls = []
+    for key, w in data.items():
+        if key == "overall":
+            continue
+        try:
+            walls.append({"center": np.asarray(w["center"], float),
+                          "direction": np.asarray(w["direction"], float),
+                          "domain": np.asarray(w["domain"], float).reshape(3, 2),
+                          "wwr": float(w["wwr"]), "area": float(w["area"])})
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"{path}: wall {key} is malformed: {exc!r}") from None
+    if not walls:
+        raise ValueError(f"{path} lists no walls")
+    centre = np.mean([w["center"] for w in walls], axis=0)
+    for w in walls:
+        n = w["direction"] / np.linalg.norm(w["direction"])
+        # The generator's direction is a face normal whose sign varies; ours points out.
+        w["normal"] = n if float((w["center"] - centre)[:2] @ n[:2]) >= 0 else -n
+        w["overall_wwr"] = float(data.get("overall", {}).get("wwr", np.nan))
+    return walls
+
+
+def read_hdr_depth_m(path: Path) -> np.ndarray:
+    """(H, W) float32 z-depth in metres of a Radiance HDR depth image (0 = background)."""
+    if not path.is_file():
+        raise ValueError(f"depth image {path} does not exist")
+    img = cv2.imread(str(path), cv2.IMREAD_ANYDEPTH | cv2.IMREAD_ANYCOLOR)
+    if img is None:
+        raise ValueError(f"{path} is not a readable Radiance HDR image")
+    depth = (img[..., 0] if img.ndim == 3 else img).astype(np.float32)
+    depth[~np.isfinite(depth) | (depth >= HDR_BACKGROUND_M)] = 0.0
+    return depth
+
+
+def facade_ids_from_walls(labels: np.ndarray, depth_z_m: np.ndarray, intrinsics: Intrinsics,
+                          world_from_camera: np.ndarray,
+                          walls: list[dict[str, Any]]) -> np.ndarray:
+    """(H, W) int32 facade id (wall index + 1, 0 = none) of every wall/window pixel.
+
+    A pixel's point (from its depth) belongs to the wall whose plane is nearest, if it is
+    within :data:`PLANE_TOLERANCE_M` of that plane and of the wall's extent.
+    """
+    facade = np.isin(labels, [SemanticClass.WALL, SemanticClass.WINDOW, SemanticClass.DOOR])
+    facade &= depth_z_m > 0
+    out = np.full(labels.shape, NO_FACADE, dtype=np.int32)
+    if not facade.any():
+        return out
+    uv = pixel_centres(intrinsics)[facade]
+    points = unproject_depth_to_world(uv, depth_z_m[facade], intrinsics, world_from_camera)
+    best = np.full(len(points), np.inf)
+    ids = np.zeros(len(points), dtype=np.int32)
+    t = PLANE_TOLERANCE_M
+    for w, wall in enumerate(walls):
+        dist = np.abs((points - wall["center"]) @ wall["normal"])
+        lo, hi = wall["domain"][:, 0] - t, wall["domain"][:, 1] + t
+        ok = (dist < t) & np.all((points >= lo) & (points <= hi), axis=1) & (dist < best)
+        best[ok], ids[ok] = dist[ok], w + 1
+    out[facade] = ids
+    return out
+
+
+def building_truth(walls: list[dict[str, Any]], building_id: str) -> BuildingTruth:
+    """Our ``building.json`` truth from the generator's walls (no doors: it has none)."""
+    facades = []
+    for w, wall in enumerate(walls):
+        d = wall["domain"]
+        window = wall["wwr"] * wall["area"]
+        gross = gross_facade_area_m2(wall["area"], window, 0.0)
+        facades.append(FacadeTruth(
+            id=w + 1, normal=tuple(float(x) for x in wall["normal"]),
+            width_m=float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0])),
+            height_m=float(d[2, 1] - d[2, 0]), window_area_m2=window,
+            wall_area_m2=wall["area"], door_area_m2=0.0, facade_area_m2=gross,
+            wwr=wwr_from_areas(window, wall["area"], 0.0)))
+    window = sum(f.window_area_m2 for f in facades)
+    wall_area = sum(f.wall_area_m2 for f in facades)
+    gross = gross_facade_area_m2(wall_area, window, 0.0)
+    z0 = min(float(w["domain"][2, 0]) for w in walls)
+    height = max(float(w["domain"][2, 1]) for w in walls) - z0
+    footprint = _footprint(walls)
+    return BuildingTruth(
+        id=building_id, type="imported", floors=max(1, round(height / 3.0)), height_m=height,
+        window_area_m2=window, facade_area_m2=gross, wall_area_m2=wall_area, door_area_m2=0.0,
+        wwr=wwr_from_areas(window, wall_area, 0.0), footprint=polygon_to_geojson(footprint),
+        footprint_area_m2=float(footprint.area), facades=tuple(facades),
+        extra={"source": "BuildNet3D-dataset wwr_information",
+               "generator_overall_wwr": walls[0]["overall_wwr"],
+               "floors_estimated_from_height_3m": True, "ground_z_m": z0})
+
+
+def _footprint(walls: list[dict[str, Any]]):
+    """The footprint polygon closed by the walls' ground lines (the largest face)."""
+    lines = []
+    for wall in walls:
+        d, n = wall["domain"], wall["normal"]
+        along = np.array([-n[1], n[0]])
+        c = wall["center"][:2]
+        half = 0.5 * float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0]))
+        lines.append(LineString([c - half * along, c + half * along]))
+    faces = list(polygonize(unary_union(lines)))
+    if not faces:
+        raise ValueError("the walls of wwr_information do not close a footprint")
+    return unary_union(faces)
+
+
+def _check_segmentation_colours(seg: dict[str, Any], path: Path) -> None:
+    palette = {tuple(c) for c in class_mapping("generator").colours or ()}
+    unknown = [v for v in seg.values() if tuple(int(x) for x in v) not in palette]
+    if unknown:
+        raise ValueError(
+            f"{path} lists colours {unknown} that the generator's palette "
+            f"{sorted(palette)} does not define; the data was made with another "
+            "segmentation_config.json"
+        )
+
+
+def _frame(stem: str, intr: Intrinsics, pose: np.ndarray, split: str,
+           facade_id: int | None) -> Frame:
+    return Frame(file_path=f"images/{stem}.png", world_from_camera=pose, intrinsics=intr,
+                 split=split, facade_id=facade_id, depth_file_path=f"depth/{stem}.png",
+                 semantic_file_path=f"semantics/{stem}.png",
+                 instance_file_path=f"instances/{stem}.png")
+
+
+def _depth_unit_m(max_depth_m: float) -> float:
+    """1 mm, or the next 1-2-5 step that holds ``max_depth_m`` in 16 bits."""
+    unit = 0.001
+    while max_depth_m / unit > DEPTH_MAX_UNITS:
+        unit *= 2.0 if str(unit)[0] in "15" else 2.5
+    return unit
+
+
+def _read_json(path: Path) -> Any:
+    if not path.is_file():
+        raise ValueError(f"{path} does not exist: not a complete BuildNet3D-dataset output")
+    try:
+        return json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path} is not valid JSON: {exc}") from None

@@ -1,0 +1,122 @@
+"""Cut the faces of a building's bodies where another body's face lies against them.
+
+BIM solids touch: a wall butts against the side of another at a corner, a window lining
+lies against its reveal. The part of a face covered by a touching body is inside the
+building, the rest may be facade; the visibility test (:mod:`dataset.rendering.visibility`) decides
+a
+face as a whole, so :func:`split_touching_faces` cuts each face along the outline of the
+opposite-facing coplanar faces that cover it -- and, where two overlapping solids are
+flush on one side, along the earlier solid's coincident face, whose twin must not count
+twice. The pieces are triangulated with shapely's constrained Delaunay triangulation;
+nothing else changes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+
+from dataset.core.mesh import LabelledMesh, plane_bases
+
+PLANE_DECIMALS_NORMAL = 6  # faces whose unit normals agree to 1e-6 are parallel
+PLANE_DECIMALS_OFFSET_M = 5  # ... and whose plane offsets agree to 10 um, coplanar
+MIN_PIECE_M2 = 1e-8  # covered or uncovered parts smaller than this are ignored
+BOX_TOLERANCE_M = 1e-9  # bounding boxes that overlap by less than this do not touch
+
+
+def split_touching_faces(
+    mesh: LabelledMesh, which: np.ndarray
+) -> tuple[LabelledMesh, np.ndarray, np.ndarray]:
+    """Cut faces in ``which`` where coplanar faces of other bodies lie on them.
+
+    Two kinds of cover: an *opposite* face (the faces touch: that part is inside the
+    building, and the rays will find it hidden) and, for two overlapping solids flush on
+    one side, an earlier face facing the *same* way (that part is the earlier face's
+    twin and must not count twice).
+
+    Parameters
+    ----------
+    mesh
+        The building: faces of touching bodies, z up, metres.
+    which : (F,) bool
+        Faces to cut (the facades' candidates); any face may cover them.
+
+    Returns
+    -------
+    mesh
+        Faces not cut in their order, then the pieces of each cut face (its label, facade
+        id and orientation).
+    parent : (F',) int64
+        Index of each output face's face in the input.
+    twin : (F',) bool
+        Pieces that an earlier same-facing face already covers.
+    """
+    normals = mesh.face_normals()
+    tri = mesh.triangles_m
+    offsets = np.einsum("ij,ij->i", normals, tri[:, 0])
+    lo, hi = tri.min(axis=1), tri.max(axis=1)
+    basis_u, basis_v = plane_bases(normals)
+    extent = hi - lo  # a face flat along an axis overlaps along it whatever its bounds
+    keys = np.concatenate([np.round(normals, PLANE_DECIMALS_NORMAL) + 0.0,
+                           np.round(offsets, PLANE_DECIMALS_OFFSET_M)[:, None] + 0.0], axis=1)
+    by_plane: dict[tuple[float, ...], list[int]] = {}
+    for j, k in enumerate(map(tuple, keys)):
+        by_plane.setdefault(k, []).append(j)
+
+    def overlapping(faces: list[int] | None, i: int) -> np.ndarray:
+        """Those of ``faces`` whose bounding boxes overlap face i's."""
+        f = np.asarray(faces if faces else [], dtype=np.int64)
+        near = np.all((lo[f] < hi[i] - BOX_TOLERANCE_M) & (hi[f] > lo[i] + BOX_TOLERANCE_M)
+                      | (extent[f] < BOX_TOLERANCE_M) | (extent[i] < BOX_TOLERANCE_M), axis=1)
+        return f[near]
+
+    new_vertices: list[np.ndarray] = []
+    piece_parent: list[int] = []
+    piece_twin: list[bool] = []
+    cut = np.zeros(len(tri), dtype=bool)
+    for i in np.flatnonzero(which & (np.linalg.norm(normals, axis=1) > 0.5)):
+        opposite = overlapping(by_plane.get(tuple(-keys[i] + 0.0)), i)
+        same = overlapping(by_plane.get(tuple(keys[i])), i)
+        same = same[same < i]
+        if len(opposite) == 0 and len(same) == 0:
+            continue
+        u, v = basis_u[i], basis_v[i]
+        origin = tri[i, 0]
+        uv = np.stack([u, v], axis=1)  # (3, 2)
+        own = Polygon((tri[i] - origin) @ uv)
+        cover = shapely.union_all(shapely.polygons((tri[opposite] - origin) @ uv)
+                                  ).intersection(own)
+        twin = shapely.union_all(shapely.polygons((tri[same] - origin) @ uv)
+                                 ).intersection(own).difference(cover)
+        rest = own.difference(cover).difference(twin)
+        if twin.area < MIN_PIECE_M2 and min(cover.area, rest.area) < MIN_PIECE_M2:
+            continue  # not covered, or wholly covered by touching faces: the rays decide
+        cut[i] = True
+        for part, is_twin in ((cover, False), (twin, True), (rest, False)):
+            if part.area < MIN_PIECE_M2:
+                continue
+            triangles = shapely.get_parts(shapely.constrained_delaunay_triangles(part))
+            xy = shapely.get_coordinates(shapely.get_exterior_ring(triangles)).reshape(-1, 4, 2)
+            new_vertices.append(origin + xy[:, :3, :1] * u + xy[:, :3, 1:2] * v)  # (T, 3, 3)
+            piece_parent.extend([int(i)] * len(xy))
+            piece_twin.extend([is_twin] * len(xy))
+    if not cut.any():
+        return mesh, np.arange(len(tri)), np.zeros(len(tri), dtype=bool)
+    corners = np.concatenate(new_vertices)
+    piece_parent_a = np.asarray(piece_parent, dtype=np.int64)
+    # Each piece turns the way its parent does.
+    turn = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    flip = np.einsum("ij,ij->i", turn, normals[piece_parent_a]) < 0
+    corners[flip] = corners[flip][:, ::-1]
+    keep = np.flatnonzero(~cut)
+    parent = np.concatenate([keep, piece_parent_a])
+    twins = np.concatenate([np.zeros(len(keep), dtype=bool), np.asarray(piece_twin)])
+    vertices = np.concatenate([mesh.vertices_m, corners.reshape(-1, 3)])
+    pieces = len(mesh.vertices_m) + np.arange(3 * len(corners)).reshape(-1, 3)
+    faces = np.concatenate([mesh.faces[keep], pieces])
+    return (LabelledMesh(vertices, faces, mesh.face_label[parent], mesh.face_facade[parent]),
+            parent, twins)
+
+
+

@@ -1,0 +1,247 @@
+"""An IFC model (ArchiCAD, Revit, ... export) -> :class:`dataset.core.truth.Building` with derived
+truth.
+
+Steps (docs/importing.md): IfcOpenShell triangulates every product in world coordinates,
+openings subtracted, in metres (:func:`read_ifc`); each element's class comes from its
+entity (:mod:`dataset.importers.ifc_classes`); the ground is the lowest storey's floor; then the
+mesh importer derives the truth (:func:`dataset.importers.mesh_import.building_from_mesh`: touching
+and
+overlapping solids are normal, nothing below the ground counts). Each IfcWindow's declared
+OverallWidth x OverallHeight is listed beside its measured exterior area.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import Counter
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.core.mesh import LabelledMesh
+from dataset.core.truth import Building
+from dataset.importers.ifc_classes import SKIP, class_of_element
+from dataset.importers.import_config import ImportConfig
+from dataset.importers.mesh_import import building_from_mesh
+
+
+@dataclass(frozen=True)
+class IfcElement:
+    """One imported IFC product: its identity, our class and, for a window, its declared
+    OverallWidth x OverallHeight in m² (None if not given)."""
+
+    global_id: str
+    ifc_type: str
+    name: str
+    label: SemanticClass
+    declared_area_m2: float | None = None
+
+
+@dataclass(frozen=True)
+class IfcModel:
+    """The triangulated building of an IFC file, world frame, metres, z up.
+
+    Attributes
+    ----------
+    mesh : LabelledMesh
+        Every element's triangles (its own vertices), classes set, facade ids 0.
+    face_element : (F,) int64
+        Index into ``elements`` of each face.
+    elements : tuple of IfcElement
+    ground_z_m : float or None
+        The lowest storey's floor level, None without storeys.
+    warnings : dict
+        Kind of problem -> how many elements had it.
+    skipped : tuple of IfcElement
+        Elements IfcOpenShell could not triangulate.
+    unit_scale : float
+        Metres per file length unit.
+    """
+
+    mesh: LabelledMesh
+    face_element: np.ndarray
+    elements: tuple[IfcElement, ...]
+    ground_z_m: float | None
+    warnings: dict[str, int]
+    skipped: tuple[IfcElement, ...]
+    unit_scale: float
+
+
+def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool = True
+             ) -> IfcModel:
+    """Triangulate an IFC file's building elements with IfcOpenShell.
+
+    Parameters
+    ----------
+    path
+        ``.ifc`` file (IFC2X3, IFC4, IFC4X3), any length unit.
+    overrides
+        :func:`dataset.importers.ifc_classes.read_class_overrides` of the user's mapping.
+    progress
+        Show a progress bar over the elements.
+
+    Raises
+    ------
+    ValueError
+        Missing or unreadable file, or no element with geometry.
+    """
+    import ifcopenshell
+    import ifcopenshell.geom
+    import ifcopenshell.util.placement
+    import ifcopenshell.util.unit
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"IFC file {path} does not exist")
+    try:
+        model = ifcopenshell.open(str(path))
+    except Exception as exc:  # IfcOpenShell raises several types on bad files
+        raise ValueError(f"cannot read {path} as IFC: {exc}") from exc
+    unit_scale = float(ifcopenshell.util.unit.calculate_unit_scale(model))
+    warnings: Counter[str] = Counter()
+    wanted: dict[int, IfcElement] = {}
+    for product in sorted(model.by_type("IfcProduct"), key=lambda p: p.GlobalId):
+        label = class_of_element(product, overrides)
+        if label == SKIP or product.Representation is None:
+            continue
+        if _has_parts(product):
+            continue  # a whole whose parts carry the geometry (curtain wall, roof)
+        wanted[product.id()] = IfcElement(product.GlobalId, product.is_a(),
+                                          product.Name or "", SemanticClass(label),
+                                          _declared_window_area_m2(product, unit_scale))
+    if not wanted:
+        raise ValueError(f"{path} has no building element with geometry (walls, slabs, ...)")
+
+    settings = ifcopenshell.geom.settings()
+    settings.set("use-world-coords", True)
+    iterator = ifcopenshell.geom.iterator(
+        settings, model, max(1, os.cpu_count() or 1), include=[model.by_id(i) for i in wanted]
+    )
+    shapes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    with tqdm(total=len(wanted), desc="IFC geometry", unit="element",
+              disable=not progress) as bar:
+        if iterator.initialize():
+            while True:
+                shape = iterator.get()
+                g = shape.geometry
+                shapes[shape.id] = (np.asarray(g.verts, dtype=np.float64).reshape(-1, 3),
+                                    np.asarray(g.faces, dtype=np.int64).reshape(-1, 3))
+                bar.update()
+                if not iterator.next():
+                    break
+    vertices, faces, face_element, elements, skipped = [], [], [], [], []
+    n_vertices = 0
+    for product_id in sorted(wanted, key=lambda i: wanted[i].global_id):
+        element = wanted[product_id]
+        v, f = shapes.get(product_id, (np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)))
+        if len(f) == 0:
+            warnings[f"skipped {element.ifc_type}: IfcOpenShell could not triangulate it"] += 1
+            skipped.append(element)
+            continue
+        vertices.append(v)
+        faces.append(f + n_vertices)
+        face_element.append(np.full(len(f), len(elements)))
+        elements.append(element)
+        n_vertices += len(v)
+    if not faces:
+        raise ValueError(f"{path}: IfcOpenShell could triangulate no element")
+    f_all = np.concatenate(faces)
+    labels = np.array([e.label for e in elements], dtype=np.uint8)[np.concatenate(face_element)]
+    mesh = LabelledMesh(np.concatenate(vertices), f_all, labels, np.full(len(f_all), NO_FACADE))
+    storeys = [ifcopenshell.util.placement.get_local_placement(s.ObjectPlacement)[2, 3]
+               for s in model.by_type("IfcBuildingStorey") if s.ObjectPlacement is not None]
+    ground = float(min(storeys)) * unit_scale if storeys else None
+    return IfcModel(mesh, np.concatenate(face_element), tuple(elements), ground,
+                    dict(sorted(warnings.items())), tuple(skipped), unit_scale)
+
+
+def import_ifc(
+    path: str | Path,
+    *,
+    building_id: str | None = None,
+    config: ImportConfig | None = None,
+    overrides: dict | None = None,
+    progress: bool = True,
+) -> Building:
+    """Read an IFC model and derive its ground truth (as :mod:`dataset.importer` does a mesh).
+
+    The ground is ``config.ground_z_m`` when given, else the lowest storey's floor (else
+    the lowest point, with a warning). Elements that are not closed solids are kept and
+    counted in the warnings. ``truth.extra["ifc"]`` holds the element counts per class,
+    the warnings and, per IfcWindow, its declared and measured exterior areas.
+
+    Raises
+    ------
+    ValueError
+        As :func:`read_ifc` and :func:`dataset.importers.mesh_import.building_from_mesh`.
+    """
+    path = Path(path)
+    config = ImportConfig() if config is None else config
+    if config.up_axis != "z":
+        raise ValueError("IFC models are z-up; leave --up-axis at z")
+    model = read_ifc(path, overrides=overrides, progress=progress)
+    warnings = dict(model.warnings)
+    if config.ground_z_m is None:
+        if model.ground_z_m is None:
+            warnings["no storey: ground at the lowest point"] = 1
+        else:
+            config = replace(config, ground_z_m=model.ground_z_m)
+    building, parent = building_from_mesh(
+        model.mesh, building_id=building_id if building_id is not None else path.stem,
+        source=path, config=config, require_closed=False,
+    )
+    open_edges = building.truth.extra["open_edges"]
+    if open_edges["open"] or open_edges["misoriented"]:
+        warnings["edges not closed or oppositely oriented (counted once per edge)"] = (
+            open_edges["open"] + open_edges["misoriented"])
+    element_of_face = model.face_element[parent]
+    building.truth.extra["ifc"] = {
+        "elements": dict(sorted(Counter(e.label.name.lower() for e in model.elements).items())),
+        "warnings": warnings,
+        "skipped": [{"global_id": e.global_id, "type": e.ifc_type, "name": e.name}
+                    for e in model.skipped],
+        "windows": _window_areas(model, building, element_of_face),
+    }
+    return building
+
+
+def _window_areas(model: IfcModel, building: Building, element_of_face: np.ndarray
+                  ) -> list[dict]:
+    """Each IfcWindow's declared OverallWidth x OverallHeight beside its measured area (m²):
+    the window-class faces of that element that belong to a facade."""
+    mesh = building.mesh
+    counted = (mesh.face_facade != NO_FACADE) & (mesh.face_label == SemanticClass.WINDOW)
+    measured = np.bincount(element_of_face[counted], weights=mesh.face_areas_m2()[counted],
+                           minlength=len(model.elements))
+    return [{"global_id": e.global_id, "name": e.name, "declared_area_m2": e.declared_area_m2,
+             "measured_area_m2": float(measured[i])}
+            for i, e in enumerate(model.elements) if e.ifc_type.startswith("IfcWindow")]
+
+
+def _declared_window_area_m2(product, unit_scale: float) -> float | None:
+    if not product.is_a("IfcWindow"):
+        return None
+    w, h = product.OverallWidth, product.OverallHeight
+    return None if w is None or h is None else float(w * h) * unit_scale ** 2
+
+
+def _has_parts(product) -> bool:
+    return any(rel.is_a("IfcRelAggregates") and rel.RelatedObjects
+               for rel in getattr(product, "IsDecomposedBy", None) or ())
+
+
+def warning_lines(ifc_record: dict, *, max_named: int = 5) -> list[str]:
+    """One line per kind of warning with its count, then the first skipped elements by name.
+
+    ``ifc_record`` is ``truth.extra["ifc"]`` of an imported building.
+    """
+    lines = [f"warning: {count} x {kind}" for kind, count in ifc_record["warnings"].items()]
+    skipped = ifc_record["skipped"]
+    lines += [f"warning: skipped {e['type']} {e['global_id']} {e['name']!r}"
+              for e in skipped[:max_named]]
+    if len(skipped) > max_named:
+        lines.append(f"warning: ... and {len(skipped) - max_named} more skipped elements")
+    return lines

@@ -1,0 +1,118 @@
+"""How a labelled mesh becomes a building: :class:`ImportConfig` and its command-line options.
+
+One place for the import options, shared by ``python -m dataset.importer`` and
+``python -m dataset.generate --mesh/--ifc``: every field of :class:`ImportConfig` is an
+option (``--ground-z``, ``--footprint-height-m``, ...), with the field's default.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, fields
+
+from dataset.importers.mesh_files import UpAxis
+
+
+@dataclass(frozen=True)
+class ImportConfig:
+    """How a labelled mesh becomes a building; lengths in metres, angles in degrees."""
+
+    up_axis: UpAxis = "z"
+    """The file's up axis: glTF exported by Blender is y-up."""
+    recentre: bool = True
+    """Move the mesh so that its x/y bounding-box centre is at the origin and its ground at
+    z = 0 (DESIGN.md's world); the shift is recorded in the truth's ``extra``."""
+    ground_z_m: float | None = None
+    """Ground level in the file's frame (after ``up_axis``): faces and face parts below it
+    are underground, never facade; ``None``: the mesh's lowest point."""
+    max_tilt_deg: float = 10.0
+    """Faces whose normal is further than this from horizontal (roof-like) are no facade."""
+    angle_tolerance_deg: float = 10.0
+    """Faces within this angle of a facade's direction join it (curved walls: sectors)."""
+    offset_tolerance_m: float = 0.3
+    """Parallel planes closer than this are one facade (windows set back into the wall)."""
+    gap_tolerance_m: float = 0.05
+    """Coplanar wall pieces further apart than this along the wall are different facades."""
+    min_facade_width_m: float = 0.5
+    """Narrower groups (window reveals, pilaster sides) belong to no facade."""
+    rays_per_sample: int = 16
+    """Ray directions per sample point (4 points per face) for the visibility test."""
+    min_escape_fraction: float = 0.02
+    """A face is seen from outside if at least this fraction of its rays escape."""
+    ray_offset_m: float = 1e-3
+    """Rays start this far off the surface (embree works in float32)."""
+    footprint_height_m: float = 0.05
+    """The footprint is the cross-section this far above the ground."""
+    floor_height_m: float = 3.0
+    """Storey height: floors = round(height / floor_height_m), at least 1."""
+
+    def __post_init__(self) -> None:
+        if self.up_axis not in ("z", "y"):
+            raise ValueError(f"up_axis must be 'z' or 'y', got {self.up_axis!r}")
+        for name in ("max_tilt_deg", "angle_tolerance_deg"):
+            if not 0 < getattr(self, name) < 90:
+                raise ValueError(f"{name} must be in (0, 90) degrees, got {getattr(self, name)}")
+        for name in ("offset_tolerance_m", "gap_tolerance_m", "min_facade_width_m"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name} must be >= 0 m, got {getattr(self, name)}")
+        for name in ("ray_offset_m", "footprint_height_m", "floor_height_m"):
+            if getattr(self, name) <= 0:
+                raise ValueError(f"{name} must be > 0 m, got {getattr(self, name)}")
+        if self.rays_per_sample < 1:
+            raise ValueError(f"rays_per_sample must be >= 1, got {self.rays_per_sample}")
+        if not 0 < self.min_escape_fraction <= 1:
+            raise ValueError(
+                f"min_escape_fraction must be in (0, 1], got {self.min_escape_fraction}"
+            )
+
+
+_HELP = {
+    "up_axis": "the file's up axis; glTF from Blender is y",
+    "ground_z_m": "ground level in the file (metres, after --up-axis): what lies below is "
+                  "underground, never facade (default: the lowest point; IFC: the lowest "
+                  "storey's floor)",
+    "max_tilt_deg": "faces tilted further than this from upright are no facade",
+    "angle_tolerance_deg": "faces within this angle of a facade's direction join it",
+    "offset_tolerance_m": "parallel planes closer than this are one facade",
+    "gap_tolerance_m": "coplanar wall pieces further apart than this are two facades",
+    "min_facade_width_m": "narrower face groups (reveals) belong to no facade",
+    "rays_per_sample": "visibility rays per sample point (4 points per face)",
+    "min_escape_fraction": "a face is seen from outside if this share of its rays escape",
+    "ray_offset_m": "rays start this far off the surface",
+    "footprint_height_m": "footprint section height above the ground",
+    "floor_height_m": "storey height for the floor count",
+}
+_FLAGS = {"ground_z_m": "--ground-z"}
+
+
+def add_import_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add one option per :class:`ImportConfig` field to ``parser`` (``recentre`` becomes
+    ``--keep-position``)."""
+    group = parser.add_argument_group("import options (docs/importing.md)")
+    defaults = ImportConfig()
+    for field in fields(ImportConfig):
+        if field.name == "recentre":
+            group.add_argument("--keep-position", action="store_true",
+                               help="keep the file's coordinates instead of centring the "
+                               "building on the origin with its ground at z = 0")
+            continue
+        flag = _FLAGS.get(field.name, "--" + field.name.replace("_", "-"))
+        default = getattr(defaults, field.name)
+        kind = {"up_axis": str, "rays_per_sample": int}.get(field.name, float)
+        group.add_argument(flag, dest=f"import_{field.name}", type=kind, default=default,
+                           metavar=None if field.name == "up_axis" else "X",
+                           choices=("z", "y") if field.name == "up_axis" else None,
+                           help=f"{_HELP[field.name]} (default: {default})")
+
+
+def import_config_from_args(args: argparse.Namespace) -> ImportConfig:
+    """The :class:`ImportConfig` that options added by :func:`add_import_arguments` ask for.
+
+    Raises
+    ------
+    ValueError
+        An option out of range.
+    """
+    values = {f.name: getattr(args, f"import_{f.name}") for f in fields(ImportConfig)
+              if f.name != "recentre"}
+    return ImportConfig(recentre=not args.keep_position, **values)

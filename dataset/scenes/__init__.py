@@ -1,0 +1,2 @@
+"""Scene folders: reading and writing ``transforms.json``, images and label masks, validation,
+and rendering a building into a scene folder."""

@@ -1,0 +1,1 @@
+"""Extraction: marching cubes, per-vertex semantics, areas and WWR per facade, footprint."""

@@ -1,0 +1,147 @@
+"""Building footprint: the zero contour of an SDF near the ground, as a shapely polygon.
+
+The SDF is sampled on a square grid of ``cell_m`` over the box's x/y extent on
+one or more horizontal planes ``z = heights_m`` and averaged over them
+(defaults in :class:`neural3d.extract.ExtractConfig`: 1 to 4 m, above the
+ground plane's reconstruction noise and below balconies and overhangs). Across
+a vertical wall the SDF does not change with z, so the average keeps the wall
+where it is while the independent wobbles of a trained field on each plane
+cancel. The grid is padded with one ring of positive (outside) samples so
+that every contour closes, even where the building meets the box edge; the
+zero contours (``skimage.measure.find_contours``, linear interpolation) become
+rings, and nesting is resolved by even-odd (symmetric difference), which keeps
+courtyards as holes. Pieces and holes smaller than ``min_area_m2`` are dropped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from shapely.geometry import MultiPolygon, Polygon
+from tqdm import tqdm
+
+from neural3d.extraction.meshing import SdfFn, check_box
+from neural3d.field.chunks import DEFAULT_CHUNK_POINTS, evaluate_in_chunks
+
+MAX_FOOTPRINT_CELLS = 4096  # per axis: 16.8 M samples
+
+
+def sample_sdf_plane(
+    sdf_fn: SdfFn,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    height_m: float,
+    *,
+    chunk_points: int = DEFAULT_CHUNK_POINTS,
+    progress: bool = False,
+) -> np.ndarray:
+    """SDF on the grid ``xs × ys`` at ``z = height_m``.
+
+    Returns
+    -------
+    (nx, ny) float64 signed distances in m, indexed [ix, iy].
+    """
+    xx, yy = np.meshgrid(xs, ys, indexing="ij")
+    pts = np.stack([xx.ravel(), yy.ravel(), np.full(xx.size, float(height_m))], axis=1)
+    values = np.concatenate([
+        evaluate_in_chunks(sdf_fn, pts[s:s + chunk_points], chunk_points)
+        for s in tqdm(range(0, len(pts), chunk_points), desc="footprint", disable=not progress)
+    ])
+    if not np.isfinite(values).all():
+        raise ValueError("the SDF returned NaN or inf on the footprint plane; check the field")
+    return values.reshape(xx.shape).astype(np.float64)
+
+
+def footprint_from_sdf(
+    sdf_fn: SdfFn,
+    box_min_m: np.ndarray,
+    box_max_m: np.ndarray,
+    *,
+    heights_m: Sequence[float],
+    cell_m: float,
+    min_area_m2: float,
+    chunk_points: int = DEFAULT_CHUNK_POINTS,
+) -> Polygon | MultiPolygon:
+    """Footprint polygon (world x/y metres) where the SDF averaged over planes is negative.
+
+    Parameters
+    ----------
+    sdf_fn : callable (N, 3) -> (N,)
+        Signed distance in m, positive outside.
+    box_min_m, box_max_m : (3,) float
+        Scene box; its x/y extent is sampled and ``heights_m`` must lie in its z range.
+    heights_m : sequence of float
+        Heights of the planes in m above the world origin (ground at z = 0) over
+        which the SDF is averaged; one value cuts a single plane.
+    cell_m : float
+        Grid spacing in m.
+    min_area_m2 : float
+        Pieces and holes smaller than this are dropped (slivers, noise).
+
+    Returns
+    -------
+    ``Polygon``, or ``MultiPolygon`` when several pieces are kept.
+
+    Raises
+    ------
+    ValueError
+        If the plane misses the building (no negative sample), lies wholly inside
+        it, nothing is left after dropping small pieces, or on bad arguments.
+    """
+    lo, hi = check_box(box_min_m, box_max_m)
+    heights = [float(h) for h in heights_m]
+    if not heights:
+        raise ValueError("heights_m is empty: give at least one footprint height")
+    for height_m in heights:
+        if not lo[2] <= height_m <= hi[2]:
+            raise ValueError(f"footprint height {height_m} m lies outside the box's z range "
+                             f"[{lo[2]:.3g}, {hi[2]:.3g}] m")
+    if not np.isfinite(cell_m) or cell_m <= 0:
+        raise ValueError(f"cell_m must be > 0, got {cell_m}")
+    if min_area_m2 < 0:
+        raise ValueError(f"min_area_m2 must be >= 0, got {min_area_m2}")
+    counts = np.floor((hi[:2] - lo[:2]) / cell_m + 1e-9).astype(int) + 1
+    if counts.max() > MAX_FOOTPRINT_CELLS:
+        raise ValueError(f"footprint grid of {tuple(counts)} cells is too large (at most "
+                         f"{MAX_FOOTPRINT_CELLS} per axis); raise cell_m")
+    xs, ys = (lo[i] + cell_m * np.arange(max(counts[i], 2)) for i in range(2))
+    values = np.mean([sample_sdf_plane(sdf_fn, xs, ys, h, chunk_points=chunk_points)
+                      for h in heights], axis=0)
+    where = f"z = {heights[0]} m" if len(heights) == 1 else f"z = {heights} m"
+    if values.min() >= 0:
+        raise ValueError(f"the plane(s) {where} miss the building (the SDF is positive "
+                         "everywhere on them); choose footprint heights within the building")
+    if values.max() <= 0:
+        raise ValueError(f"the plane(s) {where} lie wholly inside the surface; the box is "
+                         "too small or the field is degenerate")
+    return _polygon_from_grid(values, xs[0], ys[0], cell_m, min_area_m2)
+
+
+def _polygon_from_grid(
+    values: np.ndarray, x0_m: float, y0_m: float, cell_m: float, min_area_m2: float
+) -> Polygon | MultiPolygon:
+    from skimage.measure import find_contours
+
+    outside = max(float(values.max()), cell_m)
+    padded = np.pad(values, 1, constant_values=outside)
+    rings = []
+    for contour in find_contours(padded, 0.0):
+        xy = np.column_stack([x0_m + (contour[:, 0] - 1) * cell_m,
+                              y0_m + (contour[:, 1] - 1) * cell_m])
+        if len(xy) >= 4:
+            ring = Polygon(xy).buffer(0)
+            if not ring.is_empty:
+                rings.append(ring)
+    region = Polygon()
+    for ring in rings:  # even-odd: a ring inside a piece is a hole, inside a hole an island
+        region = region.symmetric_difference(ring)
+    pieces = []
+    for piece in getattr(region, "geoms", [region]):
+        if isinstance(piece, Polygon) and piece.area >= max(min_area_m2, 1e-12):
+            holes = [h for h in piece.interiors if Polygon(h).area >= min_area_m2]
+            pieces.append(Polygon(piece.exterior, holes))
+    if not pieces:
+        raise ValueError(f"no footprint piece is at least {min_area_m2} m²; lower min_area_m2 "
+                         "or check the footprint height")
+    return pieces[0] if len(pieces) == 1 else MultiPolygon(pieces)

@@ -1,0 +1,120 @@
+"""A trained semantic SDF seen in world metres: what meshing, measuring and the bench use."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from dataset.core.device import resolve_device
+from dataset.core.scene_record import scene_name
+from neural3d.config import FieldConfig, config_from_dict
+from neural3d.field.checkpoint import read_checkpoint
+from neural3d.field.chunks import DEFAULT_CHUNK_POINTS
+from neural3d.field.fields import SemanticSDF
+from neural3d.field.normalisation import Normalisation
+
+
+class TrainedField:
+    """A :class:`SemanticSDF` with its normalisation; every input and output in world metres.
+
+    Queries run without gradients, in chunks, on the field's device; inputs are
+    moved there and outputs stay there.
+    """
+
+    def __init__(self, field: SemanticSDF, normalisation: Normalisation, *, scene_dir: Path,
+                 class_names: tuple[str, ...]) -> None:
+        self.field = field
+        self.normalisation = normalisation
+        self.scene_dir = Path(scene_dir)
+        self.scene_name = scene_name(self.scene_dir)
+        self.class_names = tuple(class_names)
+        self.box_min_m = np.asarray(normalisation.box_min_m, dtype=np.float64)
+        self.box_max_m = np.asarray(normalisation.box_max_m, dtype=np.float64)
+
+    @property
+    def device(self) -> torch.device:
+        return self.field.log_inv_s.device
+
+    def sdf_m(self, points_world_m: Tensor) -> Tensor:
+        """"(N, 3)" world points (m) -> "(N,)" signed distance in metres, positive outside."""
+        x = self._unit(points_world_m)
+        with torch.no_grad():
+            out = [self.field.sdf(c) for c in x.split(DEFAULT_CHUNK_POINTS)]
+        return _cat(out, x) * self.normalisation.scale_m
+
+    def semantic_logits(self, points_world_m: Tensor) -> Tensor:
+        """"(N, 3)" world points (m) -> "(N, C)" class logits (view-independent)."""
+        x = self._unit(points_world_m)
+        with torch.no_grad():
+            out = [self.field.semantic_logits(self.field.sdf_net(c)[1])
+                   for c in x.split(DEFAULT_CHUNK_POINTS)]
+        return _cat(out, x, self.field.num_classes)
+
+    def rgb(self, points_world_m: Tensor, view_dirs_world: Tensor) -> Tensor:
+        """"(N, 3)" points (m) and "(N, 3)" view directions -> "(N, 3)" colour in [0, 1]."""
+        x = self._unit(points_world_m)
+        d = view_dirs_world.to(device=self.device, dtype=torch.float32)
+        if d.shape != x.shape:
+            raise ValueError(f"view_dirs_world must be (N, 3) like the points, got "
+                             f"{tuple(d.shape)}")
+        d = d / d.norm(dim=-1, keepdim=True).clamp(min=1e-12)
+        out = []
+        for xc, dc in zip(x.split(DEFAULT_CHUNK_POINTS), d.split(DEFAULT_CHUNK_POINTS)):
+            _, feature, grad = self.field.sdf_feature_gradient(xc, create_graph=False)
+            with torch.no_grad():
+                out.append(self.field.colour(xc, dc, grad, feature))
+        return _cat(out, x, 3)
+
+    def _unit(self, points_world_m: Tensor) -> Tensor:
+        p = torch.as_tensor(points_world_m)
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise ValueError(f"points_world_m must be (N, 3), got {tuple(p.shape)}")
+        p = p.to(device=self.device, dtype=torch.float64)
+        return self.normalisation.unit_from_world(p).to(torch.float32)
+
+
+def _cat(chunks: list[Tensor], x: Tensor, *trailing: int) -> Tensor:
+    if not chunks:
+        return torch.zeros((0, *trailing), device=x.device)
+    return torch.cat(chunks)
+
+
+def load_trained_field(run_dir: Path, *, device: torch.device) -> TrainedField:
+    """The field of a finished (or checkpointed) run folder, on ``device``.
+
+    Raises
+    ------
+    ValueError
+        If the folder lacks ``config.json``, ``run.json`` or ``checkpoint.pt``.
+    """
+    run_dir = Path(run_dir)
+    device = resolve_device(device)
+    for name in ("config.json", "run.json", "checkpoint.pt"):
+        if not (run_dir / name).is_file():
+            raise ValueError(f"{run_dir} is not a neural3d run folder: {name} is missing "
+                             "(train one with `python -m neural3d.train`)")
+    try:
+        config = config_from_dict(json.loads((run_dir / "config.json").read_text()))
+        run = json.loads((run_dir / "run.json").read_text())
+        norm = Normalisation.from_json_dict(run["normalisation"])
+        class_names = tuple(str(c) for c in run["class_names"])
+        scene_dir = Path(run["scene_dir"])
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
+            ValueError) as exc:
+        raise ValueError(f"{run_dir} holds a damaged config.json or run.json ({exc}); train "
+                         "the run again") from exc
+    field = build_field(config.model, len(class_names), norm).to(device)
+    state = read_checkpoint(run_dir / "checkpoint.pt", device)
+    field.load_state_dict(state.get("ema", state["field"]))  # the averaged weights if any
+    field.set_step(int(state["step"]))
+    field.eval()
+    return TrainedField(field, norm, scene_dir=scene_dir, class_names=class_names)
+
+
+def build_field(model_config: FieldConfig, num_classes: int, norm: Normalisation) -> SemanticSDF:
+    """A fresh :class:`SemanticSDF` for a scene box (same seed -> same weights)."""
+    return SemanticSDF(model_config, num_classes, norm.box_min_unit, norm.box_max_unit)

@@ -1,0 +1,137 @@
+"""neural3d as a benchmark method (:class:`dataset.core.method.Method`): train, then extract.
+
+Its config, :class:`Neural3dBudget`, is the step budget and the few settings a
+comparison chooses; the training and extraction configs follow from it
+(:func:`train_config`, :func:`extract_config`), and its results record all three.
+Training (and torch) is imported only when a run is needed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import Any, Literal
+
+from dataset.core.method import Method
+from dataset.core.protocols import TRAIN_PROTOCOL
+from dataset.core.results import MethodResult
+from dataset.core.scene_record import Scene
+from neural3d.config import TrainConfig, config_to_dict, preset_config
+from neural3d.extraction.extract_config import ExtractConfig
+
+RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
+EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
+LIBRARIES = ("numpy", "torch", "scipy", "scikit-image", "shapely", "trimesh", "pillow")
+
+
+@dataclass(frozen=True)
+class Neural3dBudget:
+    """How neural3d runs inside a comparison.
+
+    ``steps``: training steps per building (``None``: the preset's own
+    ``iterations``), the budget that fixes the result; ``max_minutes``: a
+    wall-clock safety cap per building (a run it stops is marked cut short);
+    ``threads``: torch CPU threads (recorded, since reductions depend on it);
+    ``resolution``, ``eval_frames``: marching-cubes resolution and eval frames
+    (``None``: neural3d's / the preset's own); ``device``: cpu or cuda.
+    """
+
+    preset: Literal["paper", "fast", "tiny"] = "fast"
+    steps: int | None = None
+    max_minutes: float = 60.0
+    threads: int = 2
+    resolution: int | None = None
+    eval_frames: int | None = None
+    device: str = "cpu"
+
+    def __post_init__(self) -> None:
+        if self.steps is not None and self.steps < 1:
+            raise ValueError(f"neural3d steps must be >= 1, got {self.steps}")
+        if not self.max_minutes > 0:
+            raise ValueError(f"neural3d max minutes must be > 0, got {self.max_minutes}")
+        if self.threads < 1:
+            raise ValueError(f"neural3d threads must be >= 1, got {self.threads}")
+        if self.resolution is not None and self.resolution < 8:
+            raise ValueError(f"neural3d resolution must be >= 8, got {self.resolution}")
+        if self.eval_frames is not None and self.eval_frames < 1:
+            raise ValueError(f"neural3d eval frames must be >= 1, got {self.eval_frames}")
+
+
+def train_config(budget: Neural3dBudget) -> TrainConfig:
+    """The preset's training config with the budget's steps and eval frames."""
+    config = preset_config(budget.preset)
+    if budget.steps is not None:
+        config = replace(config, iterations=budget.steps)
+    if budget.eval_frames is not None:
+        # Rendering the eval frames costs about as much as a minute of CPU training.
+        config = replace(config, eval_max_frames=budget.eval_frames)
+    return config
+
+
+def extract_config(budget: Neural3dBudget) -> ExtractConfig:
+    """The extraction config: neural3d's own, at the budget's resolution if it gives one."""
+    return ExtractConfig() if budget.resolution is None else ExtractConfig(
+        resolution=budget.resolution)
+
+
+def record_config(budget: Neural3dBudget) -> dict[str, Any]:
+    """What a result records: the whole extraction config (resolution, footprint planes,
+    measurement), the training config (its ``iterations`` = the step budget) and a
+    ``budget`` entry (preset, steps, safety cap, threads, device), so a result trained,
+    meshed or measured otherwise is recomputed."""
+    return {**asdict(extract_config(budget)), **_budget_record(budget)}
+
+
+def _budget_record(budget: Neural3dBudget) -> dict[str, Any]:
+    train = train_config(budget)
+    return {
+        "budget": {"preset": budget.preset, "steps": train.iterations,
+                   "max_seconds": budget.max_minutes * 60.0, "threads": budget.threads,
+                   "device": budget.device},
+        "train": config_to_dict(train),
+    }
+
+
+def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
+                 artefacts_dir: Path) -> MethodResult:
+    """Train for ``budget.steps`` steps (``neural3d.train``) into ``artefacts_dir / <scene>``,
+    then extract (``neural3d.extract``) into its ``extract`` folder.
+
+    The result records the steps trained and whether the time cap cut training short.
+    """
+    import torch
+
+    # isort sees a module as first-party only once its file exists: keep this block as is.
+    from neural3d.extract import extract_run  # noqa: I001
+    from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
+    from neural3d.train import train
+
+    config = train_config(budget)
+    torch.set_num_threads(budget.threads)
+    device = torch.device(budget.device)
+    run_dir = train(scene.root, config, artefacts_dir, device=device,
+                    max_seconds=budget.max_minutes * 60.0)
+    state = read_checkpoint(run_dir / CHECKPOINT_NAME, torch.device("cpu"))
+    steps = int(state["step"])
+    result = extract_run(run_dir, config=extract_config(budget), device=device,
+                         out_dir=run_dir / EXTRACT_FOLDER)
+    return replace(result, config={**result.config, **_budget_record(budget)}, steps=steps,
+                   cut_short=steps < config.iterations,
+                   wall_time_s=0.0)  # the runner times the whole run
+
+
+def reserve(budget: Neural3dBudget) -> tuple[float, float]:
+    """(CPUs, GPUs) one run reserves on a cluster node: a GPU (and a core to feed it) on
+    CUDA; on CPU two cores (torch trains with as many threads as the task has cores)."""
+    return (1.0, 1.0) if budget.device.startswith("cuda") else (2.0, 0.0)
+
+
+METHOD_NEURAL3D = Method(
+    name="neural3d", inputs=("rgb", "semantics", "depth", "poses"), protocols=(TRAIN_PROTOCOL,),
+    config_type=Neural3dBudget, run=run_neural3d, has_footprint=True,
+    packages=("neural3d",), libraries=LIBRARIES,
+    description="semantic neural SDF trained on the orbit views; WWR, areas and footprint "
+                "measured on its mesh (cpu or gpu: --device)",
+    record_config=record_config, reserve=reserve, artefacts=RUNS_FOLDER,
+    mesh_file=f"{EXTRACT_FOLDER}/mesh.ply", heavy=True,
+)

@@ -1,0 +1,1 @@
+"""Volume rendering of the field: ray sampling, empty-space skipping and NeuS weights."""

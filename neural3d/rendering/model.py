@@ -1,0 +1,90 @@
+"""Wiring only: rays -> samples -> field -> NeuS weights -> rendered quantities."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+from torch import Tensor
+
+from neural3d.config import TrainConfig
+from neural3d.field.fields import SemanticSDF
+from neural3d.rendering.neus import (
+    neus_alpha,
+    render_accumulation,
+    render_depth,
+    render_rgb,
+    render_semantics,
+    weights_from_alpha,
+)
+from neural3d.rendering.occupancy import OccupancyGrid
+from neural3d.rendering.sampling import neus_upsample, ray_box_near_far, uniform_samples
+
+
+@dataclass(frozen=True)
+class RenderOutput:
+    """Rendered rays (normalised frame).
+
+    rgb "(R, 3)", semantics "(R, C)" class probabilities, depth "(R,)" distance
+    along the ray (0 for the sky), accumulation "(R,)", and the SDF gradients
+    "(M, 3)" at every sample of the rays that enter the box (for the eikonal term).
+    """
+
+    rgb: Tensor
+    semantics: Tensor
+    depth: Tensor
+    accumulation: Tensor
+    sdf_gradients: Tensor
+
+
+def cos_anneal_ratio(config: TrainConfig, step: int) -> float:
+    """NeuS cos-anneal ratio at ``step``: 0 -> 1 over ``cos_anneal_steps`` (1 when 0)."""
+    if config.cos_anneal_steps <= 0:
+        return 1.0
+    return min(step / config.cos_anneal_steps, 1.0)
+
+
+def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tensor,
+                box_max: Tensor, config: TrainConfig, *, step: int, training: bool,
+                background_class: int, generator: torch.Generator | None = None,
+                occupancy: OccupancyGrid | None = None) -> RenderOutput:
+    """Render rays "(R, 3)" (unit ``dirs``) through the field inside the box "(3,)".
+
+    ``training``: jitter the uniform samples and keep the graph for the eikonal term.
+    Rays that miss the box see only the environment. ``occupancy``: clip each ray
+    to its occupied cells first (empty-space skipping).
+    """
+    near, far, hit = ray_box_near_far(origins, dirs, box_min, box_max)
+    if occupancy is not None:
+        near, far, hit = occupancy.clip_rays(origins, dirs, near, far, hit)
+    idx = torch.nonzero(hit).squeeze(1)
+    o, d = origins[idx], dirs[idx]
+    t = uniform_samples(near[idx], far[idx], config.samples_uniform, perturb=training,
+                        generator=generator)
+    t, _ = neus_upsample(field.sdf, o, d, t, config.samples_importance, config.upsample_steps)
+    t_mid = (t[:, 1:] + t[:, :-1]) * 0.5
+    lengths = t[:, 1:] - t[:, :-1]
+    n_rays, n_samples = t_mid.shape
+    pts = (o[:, None, :] + d[:, None, :] * t_mid[..., None]).reshape(-1, 3)
+    dirs_s = d[:, None, :].expand(n_rays, n_samples, 3).reshape(-1, 3)
+    sdf, feature, grad = field.sdf_feature_gradient(pts, create_graph=training)
+    rgb = field.colour(pts, dirs_s, grad, feature).reshape(n_rays, n_samples, 3)
+    logits = field.semantic_logits(feature).reshape(n_rays, n_samples, field.num_classes)
+    cos = (grad * dirs_s).sum(-1).reshape(n_rays, n_samples)
+    alpha = neus_alpha(sdf.reshape(n_rays, n_samples), cos, lengths, field.inv_s(),
+                       cos_anneal_ratio=cos_anneal_ratio(config, step))
+    weights = weights_from_alpha(alpha)
+
+    background = field.background_rgb(dirs)
+    num_classes = field.num_classes
+    sem_full = torch.zeros(len(origins), num_classes, dtype=dirs.dtype, device=dirs.device)
+    sem_full[:, background_class] = 1.0
+    zeros = torch.zeros(len(origins), dtype=dirs.dtype, device=dirs.device)
+    return RenderOutput(
+        rgb=background.index_copy(0, idx, render_rgb(weights, rgb, background[idx])),
+        semantics=sem_full.index_copy(0, idx, render_semantics(weights, logits,
+                                                               background_class)),
+        depth=zeros.index_copy(0, idx, render_depth(weights, t_mid)),
+        accumulation=zeros.index_copy(0, idx, render_accumulation(weights)),
+        sdf_gradients=grad,
+    )

@@ -1,0 +1,1 @@
+"""Training: scene pixels and the scene box, losses and held-out evaluation."""

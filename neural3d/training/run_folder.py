@@ -1,0 +1,102 @@
+"""A training run's folder: ``config.json``, ``run.json``, ``log.csv`` and ``eval.json``.
+
+``neural3d.train`` starts, resumes and logs a run through these; the
+checkpoint itself is :mod:`neural3d.field.checkpoint`.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import torch
+
+from dataset.core.atomic import write_json_atomic, write_text_atomic
+from dataset.core.results import code_version
+from dataset.core.scene_record import scene_name
+from neural3d.config import TrainConfig, config_from_dict, config_to_dict
+from neural3d.field.checkpoint import CHECKPOINT_NAME
+from neural3d.field.normalisation import Normalisation
+
+LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "depth", "psnr",
+              "inv_s", "lr")
+
+
+def start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
+                     norm: Normalisation, config: TrainConfig, device: torch.device,
+                     n_train: int) -> None:
+    """Start ``run_dir`` afresh: remove a previous run's checkpoint and logs, write the config
+    and ``run.json`` (scene, classes, background class, normalisation, device, versions)."""
+    run_dir.mkdir(parents=True, exist_ok=True)
+    for stale in (CHECKPOINT_NAME, "log.csv", "eval.json"):
+        (run_dir / stale).unlink(missing_ok=True)
+    write_json_atomic(run_dir / "config.json", config_to_dict(config))
+    write_json_atomic(run_dir / "run.json", {
+        "scene_dir": str(scene_dir.resolve()), "scene_name": scene_name(scene_dir),
+        "class_names": list(classes), "background_class": bg,
+        "normalisation": norm.to_json_dict(), "device": str(device),
+        "code_version": code_version(), "torch_version": torch.__version__,
+        "train_frames": n_train,
+    })
+
+
+def check_resumable(run_dir: Path, config: TrainConfig) -> Normalisation:
+    """The normalisation of a run that can resume with ``config``; ValueError with the reason
+    (a file missing, another config, a damaged ``run.json``) otherwise."""
+    for name in ("config.json", "run.json", CHECKPOINT_NAME):
+        if not (run_dir / name).is_file():
+            raise ValueError(f"cannot resume: {run_dir / name} does not exist (train without "
+                             "--resume first)")
+    saved = read_run_config(run_dir)
+    if saved != config:
+        raise ValueError(f"cannot resume: {run_dir} was trained with another config; resume "
+                         "with the config in its config.json")
+    try:
+        run = json.loads((run_dir / "run.json").read_text())
+        return Normalisation.from_json_dict(run["normalisation"])
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
+            ValueError) as exc:
+        raise ValueError(f"cannot resume: {run_dir / 'run.json'} is damaged ({exc}); train "
+                         "again without --resume") from exc
+
+
+def write_log(run_dir: Path, rows: list[dict]) -> None:
+    """Write ``log.csv`` (columns :data:`LOG_FIELDS`), atomically."""
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=LOG_FIELDS, restval="", extrasaction="ignore")
+    writer.writeheader()
+    writer.writerows(rows)
+    write_text_atomic(run_dir / "log.csv", buf.getvalue())
+
+
+def read_log(run_dir: Path) -> list[dict]:
+    """The rows of ``log.csv`` (none when absent)."""
+    path = run_dir / "log.csv"
+    if not path.is_file():
+        return []
+    with path.open(newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def read_evals(run_dir: Path) -> list[dict]:
+    """The evaluations in ``eval.json`` (none when absent; ValueError when damaged)."""
+    path = run_dir / "eval.json"
+    if not path.is_file():
+        return []
+    try:
+        return list(json.loads(path.read_text())["evaluations"])
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError) as exc:
+        raise ValueError(f"cannot resume: {path} is damaged ({exc}); delete it to resume "
+                         "without the evaluation history") from exc
+
+
+def read_run_config(run_dir: Path) -> TrainConfig:
+    """The config a run folder was trained with (ValueError if its config.json is unreadable)."""
+    path = Path(run_dir) / "config.json"
+    try:
+        return config_from_dict(json.loads(path.read_text()))
+    except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError) as exc:
+        raise ValueError(f"{path} is not a valid neural3d config: {exc}; train again without "
+                         "--resume") from exc

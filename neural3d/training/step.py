@@ -1,0 +1,96 @@
+"""One training step of the semantic SDF, and what it needs: optimiser, schedule, EMA, grid.
+
+:func:`train_step` is the only training step: ``neural3d.train`` loops over it
+and ``bench/neural3d.py`` times it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import partial
+
+import torch
+
+from neural3d.config import TrainConfig
+from neural3d.field.fields import SemanticSDF
+from neural3d.rendering.model import RenderOutput, render_rays
+from neural3d.rendering.occupancy import OccupancyGrid
+from neural3d.training.data import Pixels
+from neural3d.training.losses import total_loss
+
+
+def lr_factor(step: int, config: TrainConfig) -> float:
+    """Learning-rate multiplier: linear warm-up, then cosine decay to ``lr_final_factor``."""
+    if step < config.warmup:
+        return (step + 1) / config.warmup
+    progress = min((step - config.warmup) / max(config.iterations - config.warmup, 1), 1.0)
+    return config.lr_final_factor + (1 - config.lr_final_factor) * 0.5 * (
+        1 + math.cos(math.pi * progress))
+
+
+def make_optimizer(field: torch.nn.Module, config: TrainConfig
+                   ) -> tuple[torch.optim.Adam, torch.optim.lr_scheduler.LambdaLR]:
+    """Adam over all of ``field``'s parameters and its warm-up + cosine schedule."""
+    optimizer = torch.optim.Adam(field.parameters(), lr=config.lr, betas=(0.9, 0.99), eps=1e-15)
+    return optimizer, torch.optim.lr_scheduler.LambdaLR(optimizer, partial(lr_factor,
+                                                                           config=config))
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """One training step: the loss (detached), its weighted parts, the batch and its render."""
+
+    loss: float
+    parts: dict[str, float]
+    pixel_index: torch.Tensor  # "(R,)" rows of the pixels the batch used
+    render: RenderOutput
+
+
+@torch.no_grad()
+def update_ema(average: torch.nn.Module, field: torch.nn.Module, decay: float) -> None:
+    """``average`` <- decay * average + (1 - decay) * field (parameters); buffers copied."""
+    for a, p in zip(average.parameters(), field.parameters()):
+        a.lerp_(p, 1.0 - decay)
+    for a, b in zip(average.buffers(), field.buffers()):
+        a.copy_(b)
+
+
+def make_occupancy(config: TrainConfig, box_min: torch.Tensor, box_max: torch.Tensor
+                   ) -> OccupancyGrid | None:
+    """The run's occupancy grid over the box "(3,)", or None when ``occupancy_resolution`` is 0."""
+    if config.occupancy_resolution == 0:
+        return None
+    return OccupancyGrid(box_min, box_max, config.occupancy_resolution)
+
+
+def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
+               scheduler: torch.optim.lr_scheduler.LRScheduler | None, pixels: Pixels,
+               box_min: torch.Tensor, box_max: torch.Tensor, config: TrainConfig, *,
+               step: int, background_class: int, generator: torch.Generator,
+               occupancy: OccupancyGrid | None = None) -> StepResult:
+    """One optimisation step at ``step`` (the only training step; the bench calls it too).
+
+    Draws ``config.rays_per_batch`` pixels with ``generator``, renders them, takes
+    the weighted loss and one optimizer (and scheduler, if given) step. With an
+    ``occupancy`` grid, rays skip empty space; the grid is refreshed from the SDF
+    at ``occupancy_start`` and every ``occupancy_every`` steps after.
+    """
+    field.set_step(step)
+    if occupancy is not None and step >= config.occupancy_start and (
+            step - config.occupancy_start) % config.occupancy_every == 0:
+        occupancy.update_from_sdf(field.sdf, margin=config.occupancy_margin_cells * occupancy.cell)
+    idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
+                        device=pixels.rgb.device)
+    out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max, config,
+                      step=step, training=True, background_class=background_class,
+                      generator=generator, occupancy=occupancy)
+    depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
+    loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
+                             background_class=background_class, depth_t=depth_t)
+    optimizer.zero_grad(set_to_none=True)
+    loss.backward()
+    optimizer.step()
+    if scheduler is not None:
+        scheduler.step()
+    return StepResult(float(loss.detach()), parts, idx, out)
