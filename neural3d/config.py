@@ -70,7 +70,7 @@ class TrainConfig:
     mask_weight: float = 0.1  # silhouette term from the background class (0 = off)
     depth_loss: bool = False  # variant: supervise rendered depth with the depth images
     depth_weight: float = 0.1
-    # empty-space skipping (neural3d.occupancy), on in fast: ~1.9x it/s; 0 = off
+    # empty-space skipping (neural3d.rendering.occupancy), on in fast: ~1.9x it/s; 0 = off
     occupancy_resolution: int = 64  # cells along the box's longest side
     occupancy_start: int = 200  # first refresh from the SDF (the box until then)
     occupancy_every: int = 50  # steps between refreshes
