@@ -141,7 +141,7 @@ def test_2dss_ideal_wwr_within_2_percent_of_the_generators(imported):
 
 def test_unknown_colour_and_missing_layout_are_clear_errors(tmp_path, capsys):
     assert generate_main(["--buildnet3d", str(tmp_path), "--out", str(tmp_path / "o")]) == 2
-    assert "holds no BuildNet3D-dataset building" in capsys.readouterr().err
+    assert "holds no BuildNet3D building" in capsys.readouterr().err
     (tmp_path / "images/building3").mkdir(parents=True)
     (tmp_path / "images/building3/meta_data.json").write_text("{}")
     (tmp_path / "images/building3/segmentation_data.json").write_text('{"0": [1, 2, 3]}')
