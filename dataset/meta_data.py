@@ -50,13 +50,15 @@ class MetaDataLayout:
     """Where a ``meta_data.json`` flavour keeps its files and how it writes poses.
 
     Folders are relative to the folder of ``meta_data.json`` and are prefixed to the
-    frame's paths on reading (and stripped on writing).
+    frame's paths on reading (and stripped on writing). ``normals_key`` names a frame's
+    normal image (``normal_path`` is read too).
     """
 
     pose_convention: PoseConvention = "opencv"
     rgb_dir: str = ""
     segmentation_dir: str = ""
     depth_dir: str = ""
+    normals_key: str = "normal_path"
 
     def __post_init__(self) -> None:
         if self.pose_convention not in ("opencv", "opengl"):
@@ -67,7 +69,8 @@ class MetaDataLayout:
 
 SDFSTUDIO_LAYOUT = MetaDataLayout()
 BUILDNET3D_LAYOUT = MetaDataLayout(
-    pose_convention="opengl", rgb_dir="images", segmentation_dir="semantic"
+    pose_convention="opengl", rgb_dir="images", segmentation_dir="semantic",
+    normals_key="normals_path",  # buildnet_dataparser.py:89
 )
 
 
@@ -244,7 +247,7 @@ def _frame_from_json(
         facade_id=int(fr["facade_id"]) if fr.get("facade_id") is not None else None,
         depth_file_path=_join(layout.depth_dir, fr.get("depth_path")),
         semantic_file_path=_join(layout.segmentation_dir, fr.get("segmentation_path")),
-        normal_file_path=fr.get("normal_path"),
+        normal_file_path=fr.get(layout.normals_key, fr.get("normal_path")),
         instance_file_path=fr.get("instance_path"),
     )
 
@@ -263,7 +266,7 @@ def _frame_to_json(fr: Frame, layout: MetaDataLayout) -> dict[str, Any]:
     for key, folder, value in (
         ("segmentation_path", layout.segmentation_dir, fr.semantic_file_path),
         ("depth_path", layout.depth_dir, fr.depth_file_path),
-        ("normal_path", "", fr.normal_file_path),
+        (layout.normals_key, "", fr.normal_file_path),
         ("instance_path", "", fr.instance_file_path),
     ):
         if value is not None:
