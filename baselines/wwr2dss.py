@@ -57,6 +57,7 @@ from baselines.rectify import (
     rectify_labels,
 )
 from baselines.views import FacadeView, Protocol, ViewError, load_views, scene_name
+from dataset.camera import Intrinsics
 from dataset.cli_errors import check_output_folder
 from dataset.device import resolve_device
 from dataset.images import read_rgb
@@ -77,7 +78,10 @@ class Wwr2dssConfig:
     ``max_rectified_px``: cap on the rectangle's longer side. ``batch_size``:
     views warped per kornia call. ``corner_margin_px``: a corner closer than this to
     the image border (or outside) means the facade is cut off; the view is
-    skipped. ``max_corner_angle_error_deg``: largest deviation from 90 degrees
+    skipped, unless it is a bottom corner on the bottom border whose point (depth
+    and pose) lies within ``ground_contact_px`` pixels (at its depth) of the ground,
+    world z = 0: that is the facade's foot on a tightly framed photo, not a cut.
+    ``max_corner_angle_error_deg``: largest deviation from 90 degrees
     of a corner of the back-projected quadrilateral before the upright bounding
     rectangle replaces it. ``min_rectangle_fill``: a facade whose mask outline covers
     less than this share of its L x H rectangle is measured by the outline's area
@@ -91,6 +95,7 @@ class Wwr2dssConfig:
     max_rectified_px: int = 1024
     batch_size: int = 8
     corner_margin_px: float = 1.0
+    ground_contact_px: float = 2.0
     max_corner_angle_error_deg: float = 5.0
     min_rectangle_fill: float = 0.95
     seed: int = 0
@@ -107,6 +112,8 @@ class Wwr2dssConfig:
             raise ValueError("max_corner_angle_error_deg must be in (0, 90]")
         if not 0 <= self.min_rectangle_fill <= 1:
             raise ValueError("min_rectangle_fill must be in [0, 1]")
+        if not self.ground_contact_px >= 0:
+            raise ValueError("ground_contact_px must be >= 0 (0: every border corner is a cut)")
 
 
 @dataclass(frozen=True)
@@ -156,13 +163,27 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
         corners_m = upright_rectangle_m(outer_contour_uv(mask), plane, k, up_camera)
         corners = image_from_camera_uv(corners_m, k)
         source = "upright_rectangle"
-    corners_inside_image(corners, k.width, k.height, config.corner_margin_px)
+    corners_inside_image(corners, k.width, k.height, config.corner_margin_px,
+                         on_ground=corners_on_ground(corners_m, view.frame.world_from_camera,
+                                                     k, config.ground_contact_px))
     length, height = facade_size_m(corners_m)
     try:
         outline = outline_area_on_plane_m2(mask, plane, k)
     except ViewError:
         outline = float("nan")
     return ViewGeometry(view, mask, corners, corners_m, length, height, source, outline)
+
+
+def corners_on_ground(corners_m: np.ndarray, world_from_camera: np.ndarray,
+                      intrinsics: Intrinsics, contact_px: float) -> np.ndarray:
+    """(4,) bool: the bottom corners (BR, BL) of (4, 3) camera-frame corners (TL, TR, BR,
+    BL; OpenGL camera) whose world z is within ``contact_px`` pixel footprints (their
+    depth / fy) of the ground, z = 0."""
+    c = np.asarray(corners_m, dtype=np.float64)
+    pose = np.asarray(world_from_camera, dtype=np.float64)
+    z_world = c @ pose[2, :3] + pose[2, 3]
+    footprint_m = np.abs(c[:, 2]) / intrinsics.fy
+    return (np.abs(z_world) <= contact_px * footprint_m) & np.array([False, False, True, True])
 
 
 def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
