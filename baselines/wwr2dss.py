@@ -48,7 +48,11 @@ from baselines.backproject import (
 from baselines.cli import add_common_arguments, main_guarded, run_scenes
 from baselines.corners import corners_inside_image, enclosing_quadrilateral, outer_contour_uv
 from baselines.debug import colour_labels, draw_corners, write_debug_image
-from baselines.facade_mask import PlaneIsolationConfig, isolate_facade_on_plane
+from baselines.facade_mask import (
+    PlaneIsolationConfig,
+    isolate_facade_on_plane,
+    tolerance_for_depth_steps,
+)
 from baselines.rectify import (
     OUTSIDE,
     quadrilateral_area_px,
@@ -62,7 +66,7 @@ from dataset.cli_errors import check_output_folder
 from dataset.device import resolve_device
 from dataset.images import read_rgb
 from dataset.results import FacadeEstimate, MethodResult
-from dataset.scene import Scene
+from dataset.scene import DEPTH_RELATIVE_STEP_KEY, Scene
 
 METHOD = "2D-SS"
 
@@ -138,8 +142,13 @@ class ViewGeometry:
 
 
 def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
-                          rng: np.random.Generator) -> ViewGeometry:
+                          rng: np.random.Generator, *,
+                          depth_relative_step: float = 0.0) -> ViewGeometry:
     """Facade mask, corners, and the facade's length and height in one view.
+
+    ``depth_relative_step``: the scene's depth quantisation relative to the depth
+    (``transforms.json`` key ``depth_relative_step``; 0 = exact to its unit), which
+    widens the wall tolerance (:func:`baselines.facade_mask.tolerance_for_depth_steps`).
 
     Raises
     ------
@@ -150,7 +159,9 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
     if view.depth_z_m is None:
         raise ViewError("2D-SS needs a depth image")
     k = view.intrinsics
-    mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, config.isolation, rng)
+    isolation = tolerance_for_depth_steps(config.isolation, view.labels, view.depth_z_m,
+                                          depth_relative_step)
+    mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, isolation, rng)
     corners = enclosing_quadrilateral(mask)
     try:
         corners_m = corners_camera_m(corners, plane, k)
@@ -235,10 +246,11 @@ def run_2dss(scene: Scene, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssCo
     start = time.perf_counter()
     loaded = load_views(scene, protocol, depth="required")
     geometries: list[ViewGeometry] = []
+    step = float(scene.extra.get(DEPTH_RELATIVE_STEP_KEY, 0.0))
     for n, view in enumerate(loaded.views):
         try:
             geometries.append(measure_view_geometry(
-                view, config, np.random.default_rng((config.seed, n))))
+                view, config, np.random.default_rng((config.seed, n)), depth_relative_step=step))
         except ViewError as exc:
             loaded.skip(view.name, view.facade_id, str(exc))
     wwr, rectified = rectify_views(geometries, config, device, keep_images=debug_dir is not None)

@@ -47,12 +47,16 @@ from dataset.images import (
     write_rgb,
 )
 from dataset.labels import class_mapping, read_remapped_labels
-from dataset.scene import Frame, Scene, write_transforms
+from dataset.scene import DEPTH_RELATIVE_STEP_KEY, Frame, Scene, write_transforms
 from dataset.truth import BuildingTruth, FacadeTruth, write_building
 from dataset.wwr import gross_facade_area_m2, wwr_from_areas
 
 HDR_BACKGROUND_M = 1e9
 """HDR depths at or beyond this are background (the generator writes 1e10)."""
+HDR_RELATIVE_STEP = 1.0 / 128.0
+"""Radiance RGBE keeps an 8-bit mantissa in [128, 256): a depth in [2^k, 2^(k+1)) comes in
+steps of 2^k / 128, at most 1/128 of the depth (recorded as the scene's
+``depth_relative_step``)."""
 PLANE_TOLERANCE_M = 0.3
 """A pixel lies on a wall if its point is this close to the wall's plane and extent
 (windows sit in shallow reveals; the HDR depth is good to about 0.4 % of the depth)."""
@@ -149,7 +153,8 @@ def import_building(root: Path, index: int, out_dir: Path) -> Scene:
         views.append(ImportedView(stem, images / f"{stem}.png", intr, pose, "train", labels,
                                   depth, facade_ids_from_walls(labels, depth, intr, pose, walls)))
     scene = write_scene_views(out_dir, views, [w["normal"] for w in walls],
-                              {"source": "BuildNet3D-dataset", "source_building": index})
+                              {"source": "BuildNet3D-dataset", "source_building": index,
+                               DEPTH_RELATIVE_STEP_KEY: HDR_RELATIVE_STEP})
     write_building(out_dir / "building.json", building_truth(walls, f"building{index}"))
     return scene
 
