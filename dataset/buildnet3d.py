@@ -17,7 +17,10 @@ building; the facts of the format and where they come from are in docs/importing
 - split: every view is ``train``; for each wall the view that sees most of it head-on is
   also its ``ideal`` view and the next best up to five are its ``multi`` views;
 - ``building.json`` from ``wwr_information`` (window area = the wall's ``wwr`` times its
-  opaque ``area``; the generator's WWR divides by the opaque wall, ours by the gross facade).
+  opaque ``area``; the generator's WWR divides by the opaque wall, ours by the gross facade;
+  horizontal faces listed as walls are dropped);
+- ``mesh.ply`` from the segmented model ``model/{i}_segmented.ply`` when it is there
+  (:mod:`dataset.buildnet3d_model`).
 """
 
 from __future__ import annotations
@@ -35,6 +38,7 @@ import numpy as np
 from shapely.geometry import LineString
 from shapely.ops import polygonize, unary_union
 
+from dataset.buildnet3d_model import read_segmented_model
 from dataset.camera import Intrinsics, pixel_centres, unproject_depth_to_world
 from dataset.classes import NO_FACADE, SemanticClass
 from dataset.footprint import polygon_to_geojson
@@ -47,6 +51,7 @@ from dataset.images import (
     write_rgb,
 )
 from dataset.labels import class_mapping, read_remapped_labels
+from dataset.mesh import write_labelled_ply
 from dataset.scene import DEPTH_RELATIVE_STEP_KEY, Frame, Scene, write_transforms
 from dataset.truth import BuildingTruth, FacadeTruth, write_building
 from dataset.wwr import gross_facade_area_m2, wwr_from_areas
@@ -61,6 +66,8 @@ PLANE_TOLERANCE_M = 0.3
 """A pixel lies on a wall if its point is this close to the wall's plane and extent
 (windows sit in shallow reveals; the HDR depth is good to about 0.4 % of the depth)."""
 MULTI_VIEWS = 5
+HORIZONTAL_Z = 0.5
+"""A listed wall whose direction has |z| above this (of its length) is a horizontal face."""
 
 
 def find_buildings(path: str | Path) -> list[tuple[Path, int]]:
@@ -156,6 +163,9 @@ def import_building(root: Path, index: int, out_dir: Path) -> Scene:
                               {"source": "BuildNet3D-dataset", "source_building": index,
                                DEPTH_RELATIVE_STEP_KEY: HDR_RELATIVE_STEP})
     write_building(out_dir / "building.json", building_truth(walls, f"building{index}"))
+    model = root / "model" / f"{index}_segmented.ply"
+    if model.is_file():
+        write_labelled_ply(out_dir / "mesh.ply", read_segmented_model(model, walls))
     return scene
 
 
@@ -225,8 +235,12 @@ def read_walls(path: Path) -> list[dict[str, Any]]:
                           "wwr": float(w["wwr"]), "area": float(w["area"])})
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{path}: wall {key} is malformed: {exc!r}") from None
+    # The generator drops horizontal faces by comparing their normal's z with +-1 exactly
+    # (segmented_3D_model.py:372-376): one that rounding lets through is listed as a wall.
+    walls = [w for w in walls
+             if abs(w["direction"][2]) <= HORIZONTAL_Z * np.linalg.norm(w["direction"])]
     if not walls:
-        raise ValueError(f"{path} lists no walls")
+        raise ValueError(f"{path} lists no vertical walls")
     centre = np.mean([w["center"] for w in walls], axis=0)
     for w in walls:
         n = w["direction"] / np.linalg.norm(w["direction"])

@@ -19,6 +19,7 @@ from dataset.classes import SemanticClass as C
 from dataset.generate import main as generate_main
 from dataset.images import read_depth_m, read_facade_ids
 from dataset.labels import class_mapping
+from dataset.mesh import read_labelled_ply
 from dataset.render import render_view
 from dataset.scene import read_scene
 from dataset.scene_validation import read_frame_labels
@@ -74,10 +75,38 @@ def write_generator_output(root, building, views=((0, -1), (1, 0), (0, 1), (-1, 
                          "domain": np.stack([centre - half, centre + half], 1).tolist(),
                          "wwr": f.window_area_m2 / wall, "area": wall}
         window, opaque = window + f.window_area_m2, opaque + wall
+    # A horizontal face listed as a wall, as the generator's exact +-1 normal test lets
+    # one through (segmented_3D_model.py:372-376): the importer must drop it.
+    walls["4"] = {"center": [0, 0, sz], "direction": [0, 1e-7, 1.0],
+                  "domain": [[-sx / 2, sx / 2], [-sy / 2, sy / 2], [sz, sz]],
+                  "wwr": 0.0, "area": sx * sy}
     (root / "wwr_information").mkdir()
     (root / "wwr_information/building0_wwr.json").write_text(
         json.dumps({"overall": {"wwr": window / opaque}, **walls}))
+    (root / "model").mkdir()
+    write_segmented_ply(root / "model/0_segmented.ply", building.mesh)
     return truth_images
+
+
+def write_segmented_ply(path, mesh):
+    """The segmented model as Blender's PLY exporter writes it (ASCII, vertex normals and
+    colours, ``export_colors="LINEAR"``: the palette linearised), one vertex per face corner."""
+    tri = mesh.vertices_m[mesh.faces].reshape(-1, 3)
+    normals = np.repeat(np.cross(tri[1::3] - tri[::3], tri[2::3] - tri[::3]), 3, axis=0)
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    srgb = np.array([COLOUR_OF_OUR_CLASS[c] for c in mesh.face_label], float) / 255
+    linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+    rgb = np.repeat(np.round(linear * 255).astype(int), 3, axis=0)
+    lines = ["ply", "format ascii 1.0", "comment Created in Blender version 4.2.0",
+             f"element vertex {len(tri)}", *(f"property float {a}" for a in "x y z".split()),
+             *(f"property float n{a}" for a in "xyz"),
+             *(f"property uchar {c}" for c in ("red", "green", "blue", "alpha")),
+             f"element face {len(mesh.faces)}", "property list uchar uint vertex_indices",
+             "end_header"]
+    lines += [" ".join([*(f"{x:.6f}" for x in (*p, *n)), *(str(int(c)) for c in col), "255"])
+              for p, n, col in zip(tri, normals, rgb)]
+    lines += [f"3 {3 * i} {3 * i + 1} {3 * i + 2}" for i in range(len(mesh.faces))]
+    path.write_text("\n".join(lines) + "\n")
 
 
 @pytest.fixture(scope="module")
@@ -140,6 +169,20 @@ def test_2dss_ideal_wwr_within_2_percent_of_the_generators(imported):
     assert result.wwr == pytest.approx(scene.building.wwr, rel=0.02), result.wwr
     exact = dataclasses.replace(scene, extra={})
     assert run_2dss(exact, "ideal").wwr > 1.2 * scene.building.wwr
+
+
+def test_segmented_model_becomes_the_scene_mesh(imported):
+    """model/0_segmented.ply -> mesh.ply: classes from the (linearised) vertex colours,
+    facade ids from the walls; the horizontal 'wall' of the WWR json is dropped."""
+    scene, _, building, _ = imported
+    mesh = read_labelled_ply(scene.root / "mesh.ply")
+    expected = np.where(building.mesh.face_label == C.DOOR, C.WALL, building.mesh.face_label)
+    expected = np.where(expected == C.OTHER, C.ROOF, expected)
+    np.testing.assert_array_equal(mesh.face_label, expected)
+    on_facade = np.isin(expected, [C.WALL, C.WINDOW])
+    np.testing.assert_array_equal(mesh.face_facade[on_facade],
+                                  building.mesh.face_facade[on_facade])
+    assert len(scene.building.facades) == 4
 
 
 def test_unknown_colour_and_missing_layout_are_clear_errors(tmp_path, capsys):
