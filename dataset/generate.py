@@ -200,9 +200,11 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
                         '{"IfcCovering": "wall", "IfcRailing": "skip"}')
     src.add_argument("--buildnet3d", type=Path, metavar="PATH",
-                     help="BuildNet3D-dataset generator output (its root, or one "
-                          "images/building<i> folder): one scene per building, as rendered "
-                          "(render options are ignored); see docs/importing.md")
+                     help="output of an official BuildNet3D generator: the Blender "
+                          "generator's root or one images/building<i> folder, or a BlenderProc "
+                          "generator/dataparser folder (meta_data.json, images/, semantic(s)/) "
+                          "or a folder of them; one scene per building, as rendered (render "
+                          "options are ignored); see docs/importing.md")
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
     p.add_argument("--resolution", type=int, default=d.resolution,
