@@ -194,17 +194,3 @@ def test_unknown_colour_and_missing_layout_are_clear_errors(tmp_path, capsys):
     assert generate_main(["--buildnet3d", str(tmp_path / "images/building3"),
                           "--out", str(tmp_path / "o")]) == 2
     assert "palette" in capsys.readouterr().err
-
-
-def test_metrics_compare_runs_the_2d_methods_on_the_imported_scene(imported, tmp_path):
-    from metrics.compare import main as compare_main
-
-    data = imported[0].root.parent
-    argv = ["--data", str(data), "--methods", "2D-S,2D-SS", "--views", "ideal",
-            "--results", str(tmp_path / "results"), "--out", str(tmp_path / "out")]
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        assert compare_main(argv) == 0
-    from metrics.report import read_building_errors_csv
-
-    rows = read_building_errors_csv(tmp_path / "out" / "per_building.csv")
-    assert {(r.method, r.status) for r in rows} == {("2D-S", "ok"), ("2D-SS", "ok")}
