@@ -110,17 +110,23 @@ def order_corners(quad: np.ndarray) -> np.ndarray:
     return np.roll(q, -start, axis=0)
 
 
-def corners_inside_image(corners: np.ndarray, width: int, height: int, margin_px: float) -> None:
+def corners_inside_image(corners: np.ndarray, width: int, height: int, margin_px: float,
+                         on_ground: np.ndarray | None = None) -> None:
     """Raise ViewError unless every corner lies at least ``margin_px`` inside the image.
 
     A corner on or beyond the border means the facade is cut off by the frame,
-    so its size cannot be measured from this view.
+    so its size cannot be measured from this view, with one exception: a corner
+    marked ``on_ground`` ((4,) bool, from depth and pose) that is only beyond the
+    bottom border is the facade's foot, and a facade does not continue below the
+    ground; a tightly framed photo puts the foot on the border.
     """
     c = np.asarray(corners, dtype=np.float64)
-    bad = (
-        (c[:, 0] < margin_px) | (c[:, 0] > width - margin_px)
-        | (c[:, 1] < margin_px) | (c[:, 1] > height - margin_px)
-    )
+    inside_u = (c[:, 0] >= margin_px) & (c[:, 0] <= width - margin_px)
+    inside_v = (c[:, 1] >= margin_px) & (c[:, 1] <= height - margin_px)
+    bad = ~(inside_u & inside_v)
+    if on_ground is not None:
+        foot = np.asarray(on_ground, dtype=bool) & inside_u & (c[:, 1] > height - margin_px)
+        bad &= ~foot
     if bad.any():
         where = ", ".join(f"({_fmt(u)}, {_fmt(v)})" for u, v in c[bad])
         raise ViewError(

@@ -20,7 +20,7 @@ facade would otherwise cut it into strips).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -68,6 +68,25 @@ class PlaneIsolationConfig:
                 or self.fit_stride < 1):
             raise ValueError("ransac_iterations, sample_points (>= 3) and anchor_points "
                              "and fit_stride must be positive")
+
+
+def tolerance_for_depth_steps(config: PlaneIsolationConfig, labels: np.ndarray,
+                              depth_z_m: np.ndarray, relative_step: float
+                              ) -> PlaneIsolationConfig:
+    """``config`` with ``wall_tolerance_m`` raised to one depth step at the facade's far
+    depth (95th percentile of its pixels) when the depth is quantised relative to its
+    value (``relative_step`` > 0, e.g. 1/128 for Radiance HDR): a flat wall's points then
+    scatter by up to a step (32-64 m: 0.25 m), and a tighter tolerance keeps one band."""
+    if relative_step <= 0:
+        return config
+    depth = np.asarray(depth_z_m)
+    seen = depth[facade_class_mask(labels) & (depth > 0)]
+    if seen.size == 0:
+        return config
+    step_m = relative_step * float(np.percentile(seen, 95))
+    if step_m <= config.wall_tolerance_m:
+        return config
+    return replace(config, wall_tolerance_m=step_m)
 
 
 def facade_class_mask(labels: np.ndarray) -> np.ndarray:

@@ -48,7 +48,11 @@ from baselines.backproject import (
 from baselines.cli import add_common_arguments, main_guarded, run_scenes
 from baselines.corners import corners_inside_image, enclosing_quadrilateral, outer_contour_uv
 from baselines.debug import colour_labels, draw_corners, write_debug_image
-from baselines.facade_mask import PlaneIsolationConfig, isolate_facade_on_plane
+from baselines.facade_mask import (
+    PlaneIsolationConfig,
+    isolate_facade_on_plane,
+    tolerance_for_depth_steps,
+)
 from baselines.rectify import (
     OUTSIDE,
     quadrilateral_area_px,
@@ -57,10 +61,11 @@ from baselines.rectify import (
     rectify_labels,
 )
 from baselines.views import FacadeView, Protocol, ViewError, load_views
+from dataset.core.camera import Intrinsics
 from dataset.core.cli_errors import check_output_folder
 from dataset.core.device import resolve_device
 from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.scene_record import Scene, scene_name
+from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Scene, scene_name
 from dataset.scenes.images import read_rgb
 
 METHOD = "2D-SS"
@@ -77,7 +82,10 @@ class Wwr2dssConfig:
     ``max_rectified_px``: cap on the rectangle's longer side. ``batch_size``:
     views warped per kornia call. ``corner_margin_px``: a corner closer than this to
     the image border (or outside) means the facade is cut off; the view is
-    skipped. ``max_corner_angle_error_deg``: largest deviation from 90 degrees
+    skipped, unless it is a bottom corner on the bottom border whose point (depth
+    and pose) lies within ``ground_contact_px`` pixels (at its depth) of the ground,
+    world z = 0: that is the facade's foot on a tightly framed photo, not a cut.
+    ``max_corner_angle_error_deg``: largest deviation from 90 degrees
     of a corner of the back-projected quadrilateral before the upright bounding
     rectangle replaces it. ``min_rectangle_fill``: a facade whose mask outline covers
     less than this share of its L x H rectangle is measured by the outline's area
@@ -91,6 +99,7 @@ class Wwr2dssConfig:
     max_rectified_px: int = 1024
     batch_size: int = 8
     corner_margin_px: float = 1.0
+    ground_contact_px: float = 2.0
     max_corner_angle_error_deg: float = 5.0
     min_rectangle_fill: float = 0.95
     seed: int = 0
@@ -107,6 +116,8 @@ class Wwr2dssConfig:
             raise ValueError("max_corner_angle_error_deg must be in (0, 90]")
         if not 0 <= self.min_rectangle_fill <= 1:
             raise ValueError("min_rectangle_fill must be in [0, 1]")
+        if not self.ground_contact_px >= 0:
+            raise ValueError("ground_contact_px must be >= 0 (0: every border corner is a cut)")
 
 
 @dataclass(frozen=True)
@@ -131,8 +142,13 @@ class ViewGeometry:
 
 
 def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
-                          rng: np.random.Generator) -> ViewGeometry:
+                          rng: np.random.Generator, *,
+                          depth_relative_step: float = 0.0) -> ViewGeometry:
     """Facade mask, corners, and the facade's length and height in one view.
+
+    ``depth_relative_step``: the scene's depth quantisation relative to the depth
+    (``transforms.json`` key ``depth_relative_step``; 0 = exact to its unit), which
+    widens the wall tolerance (:func:`baselines.facade_mask.tolerance_for_depth_steps`).
 
     Raises
     ------
@@ -143,7 +159,9 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
     if view.depth_z_m is None:
         raise ViewError("2D-SS needs a depth image")
     k = view.intrinsics
-    mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, config.isolation, rng)
+    isolation = tolerance_for_depth_steps(config.isolation, view.labels, view.depth_z_m,
+                                          depth_relative_step)
+    mask, plane = isolate_facade_on_plane(view.labels, view.depth_z_m, k, isolation, rng)
     corners = enclosing_quadrilateral(mask)
     try:
         corners_m = corners_camera_m(corners, plane, k)
@@ -156,13 +174,27 @@ def measure_view_geometry(view: FacadeView, config: Wwr2dssConfig,
         corners_m = upright_rectangle_m(outer_contour_uv(mask), plane, k, up_camera)
         corners = image_from_camera_uv(corners_m, k)
         source = "upright_rectangle"
-    corners_inside_image(corners, k.width, k.height, config.corner_margin_px)
+    corners_inside_image(corners, k.width, k.height, config.corner_margin_px,
+                         on_ground=corners_on_ground(corners_m, view.frame.world_from_camera,
+                                                     k, config.ground_contact_px))
     length, height = facade_size_m(corners_m)
     try:
         outline = outline_area_on_plane_m2(mask, plane, k)
     except ViewError:
         outline = float("nan")
     return ViewGeometry(view, mask, corners, corners_m, length, height, source, outline)
+
+
+def corners_on_ground(corners_m: np.ndarray, world_from_camera: np.ndarray,
+                      intrinsics: Intrinsics, contact_px: float) -> np.ndarray:
+    """(4,) bool: the bottom corners (BR, BL) of (4, 3) camera-frame corners (TL, TR, BR,
+    BL; OpenGL camera) whose world z is within ``contact_px`` pixel footprints (their
+    depth / fy) of the ground, z = 0."""
+    c = np.asarray(corners_m, dtype=np.float64)
+    pose = np.asarray(world_from_camera, dtype=np.float64)
+    z_world = c @ pose[2, :3] + pose[2, 3]
+    footprint_m = np.abs(c[:, 2]) / intrinsics.fy
+    return (np.abs(z_world) <= contact_px * footprint_m) & np.array([False, False, True, True])
 
 
 def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
@@ -214,10 +246,11 @@ def run_2dss(scene: Scene, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssCo
     start = time.perf_counter()
     loaded = load_views(scene, protocol, depth="required")
     geometries: list[ViewGeometry] = []
+    step = float(scene.extra.get(DEPTH_RELATIVE_STEP_KEY, 0.0))
     for n, view in enumerate(loaded.views):
         try:
             geometries.append(measure_view_geometry(
-                view, config, np.random.default_rng((config.seed, n))))
+                view, config, np.random.default_rng((config.seed, n)), depth_relative_step=step))
         except ViewError as exc:
             loaded.skip(view.name, view.facade_id, str(exc))
     wwr, rectified = rectify_views(geometries, config, device, keep_images=debug_dir is not None)

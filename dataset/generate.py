@@ -200,9 +200,11 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
                         '{"IfcCovering": "wall", "IfcRailing": "skip"}')
     src.add_argument("--buildnet3d", type=Path, metavar="PATH",
-                     help="BuildNet3D-dataset generator output (its root, or one "
-                          "images/building<i> folder): one scene per building, as rendered "
-                          "(render options are ignored); see docs/importing.md")
+                     help="output of an official BuildNet3D generator: the Blender "
+                          "generator's root or one images/building<i> folder, or a BlenderProc "
+                          "generator/dataparser folder (meta_data.json, images/, semantic(s)/) "
+                          "or a folder of them; one scene per building, as rendered (render "
+                          "options are ignored); see docs/importing.md")
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
     p.add_argument("--resolution", type=int, default=d.resolution,
@@ -242,9 +244,9 @@ def main(argv: list[str] | None = None) -> int:
                              "use --workers to split one building's frames over processes")
         check_output_folder(args.out)
         if args.buildnet3d is not None:
-            from dataset.importers.buildnet3d import import_buildnet3d
+            from dataset.importers.official import import_official
 
-            scenes = import_buildnet3d(args.buildnet3d, args.out, overwrite=args.overwrite)
+            scenes = import_official(args.buildnet3d, args.out, overwrite=args.overwrite)
         elif args.preset is not None:
             _check_resources(args, config)
             ray = RayConfig(address=args.ray_address) if args.executor == "ray" else None

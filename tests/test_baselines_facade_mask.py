@@ -10,9 +10,11 @@ from baselines.facade_mask import (
     facade_class_mask,
     isolate_facade_2ds,
     isolate_facade_on_plane,
+    tolerance_for_depth_steps,
 )
 from baselines.views import ViewError
 from dataset.core.camera import Intrinsics, look_at
+from dataset.core.classes import SemanticClass
 
 L_M, H_M = 12.0, 9.0
 K = Intrinsics.from_fov(256, 256, 60.0)
@@ -110,3 +112,12 @@ def test_occluders_bridge_the_2ds_component():
     assert mask.sum() == 8 * 20 + 14 * 20 and not mask[10:14].any()
     labels[10:14] = 0  # background instead: the strips are separate facades
     assert isolate_facade_2ds(labels).sum() == 14 * 20
+
+
+def test_wall_tolerance_grows_to_one_relative_depth_step():
+    labels = np.full((4, 4), SemanticClass.WALL, np.uint8)
+    config = PlaneIsolationConfig()
+    far = tolerance_for_depth_steps(config, labels, np.full((4, 4), 40.0), 1 / 128)
+    assert far.wall_tolerance_m == pytest.approx(40.0 / 128)
+    assert tolerance_for_depth_steps(config, labels, np.full((4, 4), 2.0), 1 / 128) == config
+    assert tolerance_for_depth_steps(config, labels, np.full((4, 4), 40.0), 0.0) == config

@@ -13,7 +13,6 @@ ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
 # Importers that issue 17 works on at the same time as this check was written; their frame
 # splits are converted to dataset.core.protocols' names when both branches meet.
-PENDING = {"dataset/importers/buildnet3d.py", "dataset/importers/meta_data.py"}
 
 
 def sources() -> list[Path]:
@@ -48,8 +47,6 @@ def test_protocol_and_split_names_are_spelled_only_in_dataset_protocols():
     spelled = []
     for path in sources():
         name = str(path.relative_to(ROOT))
-        if name in PENDING:
-            continue
         spelled += [f"{name}:{line} {value!r}" for line, value in code_strings(path)
                     if value in ("ideal", "multi", "train", "eval")]
     assert spelled and all(s.startswith("dataset/core/protocols.py:") for s in spelled), spelled

@@ -18,6 +18,9 @@ from dataset.core.protocols import Split
 from dataset.core.truth import BuildingTruth
 
 DEFAULT_DEPTH_UNIT_M = 0.001  # 16-bit depth PNG in millimetres: up to 65.5 m
+DEPTH_RELATIVE_STEP_KEY = "depth_relative_step"
+"""Optional top-level ``transforms.json`` key: the depth's quantisation step as a fraction
+of the depth, where its source was coarser than the PNG unit (Radiance HDR: 1/128)."""
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,7 @@
 """Import the BuildNet3D-dataset Blender generator's output as project scenes.
 
-``python -m dataset.generate --buildnet3d PATH --out DIR`` calls :func:`import_buildnet3d`.
+``python -m dataset.generate --buildnet3d PATH --out DIR`` calls it through
+:func:`dataset.importers.official.import_official`.
 PATH is the generator's output root (``images/building{i}/meta_data.json`` for every
 building) or one ``images/building{i}`` folder. One scene folder ``DIR/building{i}`` per
 building; the facts of the format and where they come from are in docs/importing.md.
@@ -17,7 +18,10 @@ building; the facts of the format and where they come from are in docs/importing
 - split: every view is ``train``; for each wall the view that sees most of it head-on is
   also its ``ideal`` view and the next best up to five are its ``multi`` views;
 - ``building.json`` from ``wwr_information`` (window area = the wall's ``wwr`` times its
-  opaque ``area``; the generator's WWR divides by the opaque wall, ours by the gross facade).
+  opaque ``area``; the generator's WWR divides by the opaque wall, ours by the gross facade;
+  horizontal faces listed as walls are dropped);
+- ``mesh.ply`` from the segmented model ``model/{i}_segmented.ply`` when it is there
+  (:mod:`dataset.importers.buildnet3d_model`).
 """
 
 from __future__ import annotations
@@ -25,6 +29,8 @@ from __future__ import annotations
 import json
 import re
 import shutil
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -36,9 +42,12 @@ from shapely.ops import polygonize, unary_union
 from dataset.core.camera import Intrinsics, pixel_centres, unproject_depth_to_world
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
-from dataset.core.scene_record import Frame, Scene
+from dataset.core.mesh import write_labelled_ply
+from dataset.core.protocols import IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
+from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Frame, Scene
 from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
 from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.importers.buildnet3d_model import read_segmented_model
 from dataset.scenes.images import (
     DEPTH_MAX_UNITS,
     read_rgb,
@@ -52,14 +61,20 @@ from dataset.scenes.scene import write_transforms
 
 HDR_BACKGROUND_M = 1e9
 """HDR depths at or beyond this are background (the generator writes 1e10)."""
+HDR_RELATIVE_STEP = 1.0 / 128.0
+"""Radiance RGBE keeps an 8-bit mantissa in [128, 256): a depth in [2^k, 2^(k+1)) comes in
+steps of 2^k / 128, at most 1/128 of the depth (recorded as the scene's
+``depth_relative_step``)."""
 PLANE_TOLERANCE_M = 0.3
 """A pixel lies on a wall if its point is this close to the wall's plane and extent
 (windows sit in shallow reveals; the HDR depth is good to about 0.4 % of the depth)."""
 MULTI_VIEWS = 5
+HORIZONTAL_Z = 0.5
+"""A listed wall whose direction has |z| above this (of its length) is a horizontal face."""
 
 
 def find_buildings(path: str | Path) -> list[tuple[Path, int]]:
-    """(dataset root, building index) of every building under ``path``.
+    """(dataset root, building index) of every BuildNet3D-dataset building under ``path``.
 
     Raises
     ------
@@ -76,42 +91,52 @@ def find_buildings(path: str | Path) -> list[tuple[Path, int]]:
         if (m := re.fullmatch(r"building(\d+)", p.parent.name))
     )
     if not found:
-        hint = (" (it looks like the BlenderProc layout, which this importer does not read "
-                "yet)" if (path / "semantic").is_dir() or (path / "semantics").is_dir() else "")
         raise ValueError(
-            f"{path} holds no BuildNet3D-dataset building: expected images/building<i>/"
-            f"meta_data.json under it, or an images/building<i> folder{hint}"
+            f"{path} holds no BuildNet3D building: expected images/building<i>/meta_data.json "
+            "under it or an images/building<i> folder (BuildNet3D-dataset generator), or "
+            "meta_data.json with images/ and semantic/ or semantics/ beside it, in it or in "
+            "its sub-folders (BlenderProc generator or dataparser)"
         )
     return [(path, index) for index, _ in found]
 
 
 def import_buildnet3d(path: str | Path, out_root: str | Path, *,
                       overwrite: bool = False) -> list[Path]:
-    """Import every building under ``path`` into ``out_root``; return the scene folders.
+    """Import every building of this generator's layout under ``path`` into ``out_root``;
+    return the scene folders (:func:`dataset.importers.official.import_official` picks the
+    layout).
 
     Each scene is written into a temporary folder and renamed when finished, so a scene
     folder with its final name is always complete. An existing scene is kept unless
     ``overwrite``.
     """
     out_root = Path(out_root)
-    out_root.mkdir(parents=True, exist_ok=True)
-    scenes = []
-    for root, index in find_buildings(path):
-        final = out_root / f"building{index}"
-        if final.exists() and not overwrite:
-            scenes.append(final)
-            continue
-        tmp = out_root / f".building{index}.partial"
+    return [write_atomically(out_root / f"building{index}",
+                             lambda tmp, root=root, index=index: import_building(root, index, tmp),
+                             overwrite=overwrite)
+            for root, index in find_buildings(path)]
+
+
+def write_atomically(final: Path, write: Callable[[Path], object], *,
+                     overwrite: bool = False) -> Path:
+    """``write(tmp)`` a scene into a temporary sibling of ``final``, then rename it ``final``.
+
+    An existing ``final`` is kept unless ``overwrite``; a failed or interrupted write
+    leaves nothing behind.
+    """
+    if final.exists() and not overwrite:
+        return final
+    final.parent.mkdir(parents=True, exist_ok=True)
+    tmp = final.parent / f".{final.name}.partial"
+    shutil.rmtree(tmp, ignore_errors=True)
+    try:
+        write(tmp)
+    except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
-        try:
-            import_building(root, index, tmp)
-        except BaseException:
-            shutil.rmtree(tmp, ignore_errors=True)
-            raise
-        shutil.rmtree(final, ignore_errors=True)
-        tmp.rename(final)
-        scenes.append(final)
-    return scenes
+        raise
+    shutil.rmtree(final, ignore_errors=True)
+    tmp.rename(final)
+    return final
 
 
 def import_building(root: Path, index: int, out_dir: Path) -> Scene:
@@ -121,12 +146,8 @@ def import_building(root: Path, index: int, out_dir: Path) -> Scene:
     _check_segmentation_colours(_read_json(images / "segmentation_data.json"),
                                 images / "segmentation_data.json")
     walls = read_walls(root / "wwr_information" / f"building{index}_wwr.json")
-    for sub in ("images", "semantics", "depth", "instances"):
-        (out_dir / sub).mkdir(parents=True, exist_ok=True)
     width, height = int(meta["width"]), int(meta["height"])
-    frames: list[Frame] = []
-    pixels_per_wall: list[np.ndarray] = []
-    loaded = []
+    views = []
     for fr in meta["frames"]:
         stem = Path(fr["rgb_path"]).stem  # building_{i}_{v}
         k = np.asarray(fr["intrinsics"], dtype=np.float64)
@@ -136,29 +157,63 @@ def import_building(root: Path, index: int, out_dir: Path) -> Scene:
         labels = read_remapped_labels(root / "masks" / f"building{index}" /
                                       f"{stem}_mask0001.png", class_mapping("generator"))
         depth = read_hdr_depth_m(root / "depths" / f"building{index}" / f"{stem}_depth0001.hdr")
-        fids = facade_ids_from_walls(labels, depth, intr, pose, walls)
-        loaded.append((stem, intr, pose, labels, depth, fids))
-        pixels_per_wall.append(np.array([
-            np.count_nonzero(fids == w + 1) * max(0.0, float(pose[:3, 2] @ wall["normal"]))
-            for w, wall in enumerate(walls)]))
-    unit = _depth_unit_m(max(float(d.max(initial=0.0)) for *_, d, _ in loaded))
-    for stem, intr, pose, labels, depth, fids in loaded:
-        write_rgb(out_dir / "images" / f"{stem}.png",
-                  read_rgb(images / f"{stem}.png"))
-        write_labels(out_dir / "semantics" / f"{stem}.png", labels)
-        write_depth_m(out_dir / "depth" / f"{stem}.png", depth, unit)
-        write_facade_ids(out_dir / "instances" / f"{stem}.png", fids)
-        frames.append(_frame(stem, intr, pose, "train", None))
-    score = np.array(pixels_per_wall)  # (views, walls)
-    for w in range(len(walls)):
-        order = [v for v in np.argsort(-score[:, w], kind="stable") if score[v, w] > 0]
-        for rank, v in enumerate(order[: 1 + MULTI_VIEWS]):
-            stem, intr, pose, *_ = loaded[v]
-            frames.append(_frame(stem, intr, pose, "ideal" if rank == 0 else "multi", w + 1))
-    scene = Scene(root=out_dir, frames=tuple(frames), depth_unit_scale_factor=unit,
-                  extra={"source": "BuildNet3D-dataset", "source_building": index})
-    write_transforms(out_dir, scene)
+        views.append(ImportedView(stem, images / f"{stem}.png", intr, pose, TRAIN_PROTOCOL, labels,
+                                  depth, facade_ids_from_walls(labels, depth, intr, pose, walls)))
+    scene = write_scene_views(out_dir, views, [w["normal"] for w in walls],
+                              {"source": "BuildNet3D-dataset", "source_building": index,
+                               DEPTH_RELATIVE_STEP_KEY: HDR_RELATIVE_STEP})
     write_building(out_dir / "building.json", building_truth(walls, f"building{index}"))
+    model = root / "model" / f"{index}_segmented.ply"
+    if model.is_file():
+        write_labelled_ply(out_dir / "mesh.ply", read_segmented_model(model, walls))
+    return scene
+
+
+@dataclass(frozen=True)
+class ImportedView:
+    """One official view, read: labels (H, W) uint8 ours, depth (H, W) float z-depth m
+    (0 = none), facade ids (H, W) int32 (0 = none); ``split`` train or eval."""
+
+    stem: str
+    rgb_path: Path
+    intrinsics: Intrinsics
+    world_from_camera: np.ndarray
+    split: str
+    labels: np.ndarray
+    depth_z_m: np.ndarray
+    facade_ids: np.ndarray
+
+
+def write_scene_views(out_dir: Path, views: list[ImportedView], normals: list[np.ndarray],
+                      extra: dict[str, Any]) -> Scene:
+    """Write imported views as a scene in ``out_dir``; return it (without truth).
+
+    Every view is a frame of its split; for each facade ``f`` (``normals[f - 1]`` its
+    outward unit normal) the view that sees most of it head-on (pixels times the cosine
+    between the camera's back axis and the normal) is also its ``ideal`` view and the next
+    :data:`MULTI_VIEWS` its ``multi`` views.
+    """
+    for sub in ("images", "semantics", "depth", "instances"):
+        (out_dir / sub).mkdir(parents=True, exist_ok=True)
+    unit = _depth_unit_m(max(float(v.depth_z_m.max(initial=0.0)) for v in views))
+    frames: list[Frame] = []
+    for v in views:
+        write_rgb(out_dir / "images" / f"{v.stem}.png", read_rgb(v.rgb_path))
+        write_labels(out_dir / "semantics" / f"{v.stem}.png", v.labels)
+        write_depth_m(out_dir / "depth" / f"{v.stem}.png", v.depth_z_m, unit)
+        write_facade_ids(out_dir / "instances" / f"{v.stem}.png", v.facade_ids)
+        frames.append(_frame(v.stem, v.intrinsics, v.world_from_camera, v.split, None))
+    score = np.array([[np.count_nonzero(v.facade_ids == f + 1)
+                       * max(0.0, float(v.world_from_camera[:3, 2] @ n))
+                       for f, n in enumerate(normals)] for v in views]).reshape(len(views), -1)
+    for f in range(score.shape[1]):
+        order = [i for i in np.argsort(-score[:, f], kind="stable") if score[i, f] > 0]
+        for rank, i in enumerate(order[: 1 + MULTI_VIEWS]):
+            v = views[i]
+            frames.append(_frame(v.stem, v.intrinsics, v.world_from_camera,
+                                 IDEAL_PROTOCOL if rank == 0 else MULTI_PROTOCOL, f + 1))
+    scene = Scene(root=out_dir, frames=tuple(frames), depth_unit_scale_factor=unit, extra=extra)
+    write_transforms(out_dir, scene)
     return scene
 
 
@@ -180,8 +235,12 @@ def read_walls(path: Path) -> list[dict[str, Any]]:
                           "wwr": float(w["wwr"]), "area": float(w["area"])})
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{path}: wall {key} is malformed: {exc!r}") from None
+    # The generator drops horizontal faces by comparing their normal's z with +-1 exactly
+    # (segmented_3D_model.py:372-376): one that rounding lets through is listed as a wall.
+    walls = [w for w in walls
+             if abs(w["direction"][2]) <= HORIZONTAL_Z * np.linalg.norm(w["direction"])]
     if not walls:
-        raise ValueError(f"{path} lists no walls")
+        raise ValueError(f"{path} lists no vertical walls")
     centre = np.mean([w["center"] for w in walls], axis=0)
     for w in walls:
         n = w["direction"] / np.linalg.norm(w["direction"])

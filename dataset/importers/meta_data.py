@@ -30,7 +30,7 @@ import numpy as np
 
 from dataset.core.atomic import write_json_atomic
 from dataset.core.camera import Intrinsics
-from dataset.core.protocols import SPLITS
+from dataset.core.protocols import SPLITS, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEFAULT_DEPTH_UNIT_M, Frame, Scene
 from dataset.scenes.labels import (  # noqa: F401  (re-exported: the mappings lived here)
     ClassIds,
@@ -52,13 +52,15 @@ class MetaDataLayout:
     """Where a ``meta_data.json`` flavour keeps its files and how it writes poses.
 
     Folders are relative to the folder of ``meta_data.json`` and are prefixed to the
-    frame's paths on reading (and stripped on writing).
+    frame's paths on reading (and stripped on writing). ``normals_key`` names a frame's
+    normal image (``normal_path`` is read too).
     """
 
     pose_convention: PoseConvention = "opencv"
     rgb_dir: str = ""
     segmentation_dir: str = ""
     depth_dir: str = ""
+    normals_key: str = "normal_path"
 
     def __post_init__(self) -> None:
         if self.pose_convention not in ("opencv", "opengl"):
@@ -69,7 +71,8 @@ class MetaDataLayout:
 
 SDFSTUDIO_LAYOUT = MetaDataLayout()
 BUILDNET3D_LAYOUT = MetaDataLayout(
-    pose_convention="opengl", rgb_dir="images", segmentation_dir="semantic"
+    pose_convention="opengl", rgb_dir="images", segmentation_dir="semantic",
+    normals_key="normals_path",  # buildnet_dataparser.py:89
 )
 
 
@@ -236,7 +239,7 @@ def _frame_from_json(
     k = np.asarray(fr["intrinsics"], dtype=np.float64)
     if k.shape not in ((3, 3), (4, 4)):
         raise ValueError(f"frame {name}: intrinsics must be 3x3 or 4x4, got {k.shape}")
-    split = fr.get("split", "train")
+    split = fr.get("split", TRAIN_PROTOCOL)
     if split not in SPLITS:
         raise ValueError(f"frame {name}: unknown split {split!r}; expected one of {SPLITS}")
     return Frame(
@@ -248,7 +251,7 @@ def _frame_from_json(
         facade_id=int(fr["facade_id"]) if fr.get("facade_id") is not None else None,
         depth_file_path=_join(layout.depth_dir, fr.get("depth_path")),
         semantic_file_path=_join(layout.segmentation_dir, fr.get("segmentation_path")),
-        normal_file_path=fr.get("normal_path"),
+        normal_file_path=fr.get(layout.normals_key, fr.get("normal_path")),
         instance_file_path=fr.get("instance_path"),
     )
 
@@ -267,7 +270,7 @@ def _frame_to_json(fr: Frame, layout: MetaDataLayout) -> dict[str, Any]:
     for key, folder, value in (
         ("segmentation_path", layout.segmentation_dir, fr.semantic_file_path),
         ("depth_path", layout.depth_dir, fr.depth_file_path),
-        ("normal_path", "", fr.normal_file_path),
+        (layout.normals_key, "", fr.normal_file_path),
         ("instance_path", "", fr.instance_file_path),
     ):
         if value is not None:

@@ -1,0 +1,34 @@
+"""metrics.compare --data on scenes imported from both official layouts: 2D-S, 2D-SS and
+neural3d (tiny budget: the run, not its accuracy, is checked here) all finish."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+
+from test_blenderproc import write_blenderproc_output
+from test_buildnet3d import write_generator_output
+
+from dataset.generate import main as generate_main
+
+
+def test_metrics_compare_runs_every_method_on_imported_scenes(box_building, tmp_path):
+    from metrics.compare import main as compare_main
+    from metrics.report import read_building_errors_csv
+
+    write_generator_output(tmp_path / "blender", box_building)
+    write_blenderproc_output(tmp_path / "bproc" / "house", box_building, "generator")
+    data = tmp_path / "scenes"
+    with contextlib.redirect_stdout(io.StringIO()):
+        for src in ("blender", "bproc"):
+            assert generate_main(["--buildnet3d", str(tmp_path / src), "--out", str(data)]) == 0
+    argv = ["--data", str(data), "--methods", "2D-S,2D-SS,neural3d", "--views", "ideal",
+            "--neural3d-preset", "tiny", "--neural3d-steps", "30",
+            "--neural3d-resolution", "32", "--neural3d-threads", "2",
+            "--results", str(tmp_path / "results"), "--out", str(tmp_path / "out")]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert compare_main(argv) == 0
+    rows = read_building_errors_csv(tmp_path / "out" / "per_building.csv")
+    assert {(r.scene, r.method, r.status) for r in rows} == {
+        (scene, method, "ok") for scene in ("building0", "house")
+        for method in ("2D-S", "2D-SS", "neural3d")}
