@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import torch
 
-from neural3d.field.encoding import GridEncoding, _FlatGather, positional_encoding
+from neural3d.field.encoding import (GridEncoding, _FlatGather, gather_rows, positional_encoding,
+                                     scatter_add_rows)
 
 
 def test_positional_encoding_values():
@@ -37,6 +38,11 @@ def test_trilinear_interpolation_reproduces_linear_functions():
     u = (x - enc.box_min) / enc.box_size * res
     expected = u[:, 0] + 2 * u[:, 1] + 3 * u[:, 2]
     assert torch.allclose(enc(x)[:, 0], expected, atol=1e-4)
+    # Its gradient is the constant (1, 2, 3) per cell, times cells per unit length.
+    x.requires_grad_(True)
+    (grad,) = torch.autograd.grad(enc(x)[:, 0].sum(), x)
+    per_unit = res / enc.box_size * torch.tensor([1.0, 2.0, 3.0])
+    assert torch.allclose(grad, per_unit.expand_as(grad), rtol=1e-4)
 
 
 def test_cells_follow_the_box_aspect_and_hash_fine_levels():
@@ -55,6 +61,20 @@ def test_flat_gather_backward_matches_indexing():
     (a,) = torch.autograd.grad((_FlatGather.apply(table, index) * g).sum(), table)
     (b,) = torch.autograd.grad((table[index] * g).sum(), table)
     assert torch.allclose(a, b, atol=1e-6)
+
+
+@pytest.mark.parametrize("features", [1, 2, 3, 4])
+def test_row_gather_and_its_scatter_match_indexing(features):
+    """The wide-element gather is exact; the bincount scatter equals index_add to 1e-5."""
+    gen = torch.Generator().manual_seed(features)
+    table = torch.randn(50, features, generator=gen)
+    index = torch.randint(0, 50, (9, 5, 8), generator=gen)
+    assert torch.equal(gather_rows(table, index), table[index])
+    grad = torch.randn(9, 5, 8, features, generator=gen)
+    expected = torch.zeros_like(table).index_add_(0, index.reshape(-1),
+                                                  grad.reshape(-1, features))
+    got = scatter_add_rows(grad, index, 50)
+    assert got.dtype == table.dtype and torch.allclose(got, expected, atol=1e-5)
 
 
 def test_coarse_to_fine_masks_levels():
