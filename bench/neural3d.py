@@ -1,13 +1,16 @@
 """Speed and time-to-accuracy of the semantic neural SDF; prints Markdown, writes JSON.
 
-    python bench/neural3d.py speed --scene DIR [--device cpu|cuda] [--steps 5]
+    python bench/neural3d.py speed --scene DIR [--device cpu|cuda] [--steps 20] [--warmup 250]
+        [--cases grid,mlp-paper,mlp-fast]
     python bench/neural3d.py converge --benchmark DIR [--minutes 30] [--check-every 100]
 
 ``speed``: training iterations per second of each backbone at its preset's
 batch (``fast`` = grid, ``paper`` = mlp) and of the mlp at ``fast``'s batch,
-on one scene, after one warm-up step. Given per wall-clock second and per CPU
-second of this process: on a machine shared with other jobs the CPU figure is
-the one that does not depend on the neighbours.
+on one scene, timed over ``--steps`` steps after ``--warmup`` untimed ones. The
+occupancy grid (where the config has one) is refreshed from step 0 on, so the
+timed steps skip empty space as training does once it is under way. Given per
+wall-clock second and per CPU second of this process: on a machine shared with
+other jobs the CPU figure is the one that depends least on the neighbours.
 
 ``converge``: trains ``fast`` on every scene folder of ``--benchmark`` (e.g. the
 tiny preset, one building per family) and every ``--check-every`` iterations
@@ -44,15 +47,19 @@ from neural3d.training.data import (  # noqa: E402
     load_frames,
     scene_normalisation,
 )
-from neural3d.training.step import make_optimizer, train_step  # noqa: E402
+from neural3d.training.step import make_occupancy, make_optimizer, train_step  # noqa: E402
 
 WWR_TARGET_PCT = 5.0
 IOU_TARGET = 0.96
 
 
 def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.device,
-                          steps: int) -> tuple[float, float]:
-    """(iterations per wall second, per process CPU second) of the training step."""
+                          steps: int, warmup: int = 1) -> tuple[float, float]:
+    """(iterations per wall second, per process CPU second) of the training step.
+
+    ``warmup`` untimed steps first; the occupancy grid (if any) starts at step 0.
+    """
+    config = replace(config, occupancy_start=0)
     scene = read_scene(scene_dir)
     bg = background_class(scene)
     frames = load_frames(scene, "train", image_scale=config.image_scale)
@@ -64,16 +71,18 @@ def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.de
     lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
     gen = torch.Generator(device=device).manual_seed(0)
+    occupancy = make_occupancy(config, lo, hi)
 
     def step(i: int) -> None:
         train_step(field, optimizer, scheduler, px, lo, hi, config, step=i,
-                   background_class=bg, generator=gen)
+                   background_class=bg, generator=gen, occupancy=occupancy)
         if device.type == "cuda":
             torch.cuda.synchronize(device)
 
-    step(0)  # warm-up: allocator, first-call overheads
+    for i in range(max(warmup, 1)):  # allocator, first calls, the grid's first refreshes
+        step(i)
     wall, cpu = time.perf_counter(), time.process_time()
-    for i in range(1, steps + 1):
+    for i in range(max(warmup, 1), max(warmup, 1) + steps):
         step(i)
     return steps / (time.perf_counter() - wall), steps / (time.process_time() - cpu)
 
@@ -82,13 +91,19 @@ def speed(args: argparse.Namespace) -> dict:
     device = resolve_device(args.device)
     fast, paper = preset_config("fast"), preset_config("paper")
     cases = {
-        "grid (fast preset)": fast,
-        "mlp (paper preset)": paper,
-        "mlp at the fast batch": replace(fast, model=paper.model),
+        "grid": ("grid (fast preset)", fast),
+        "mlp-paper": ("mlp (paper preset)", paper),
+        "mlp-fast": ("mlp at the fast batch", replace(fast, model=paper.model)),
     }
+    unknown = set(args.cases) - set(cases)
+    if unknown:
+        raise ValueError(f"unknown --cases {', '.join(sorted(unknown))}; "
+                         f"choose from {', '.join(cases)}")
     rows = []
-    for name, config in cases.items():
-        per_wall, per_cpu = iterations_per_second(args.scene, config, device, args.steps)
+    for key in args.cases:
+        name, config = cases[key]
+        per_wall, per_cpu = iterations_per_second(args.scene, config, device, args.steps,
+                                                  args.warmup)
         samples = config.samples_uniform + config.samples_importance
         rows.append({"case": name, "device": str(device), "rays": config.rays_per_batch,
                      "samples": samples, "it_per_s": per_wall, "it_per_cpu_s": per_cpu})
@@ -196,7 +211,12 @@ def main(argv: list[str] | None = None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     sp = sub.add_parser("speed", help="training iterations per second per backbone")
     sp.add_argument("--scene", type=Path, required=True, help="a scene folder")
-    sp.add_argument("--steps", type=int, default=5)
+    sp.add_argument("--steps", type=int, default=20, help="timed steps (default 20)")
+    sp.add_argument("--warmup", type=int, default=250,
+                    help="untimed steps first, so the occupancy grid is refreshed (default 250)")
+    sp.add_argument("--cases", type=lambda v: v.split(","), default=["grid", "mlp-paper",
+                                                                     "mlp-fast"],
+                    help="comma-separated: grid, mlp-paper, mlp-fast (default all)")
     cv = sub.add_parser("converge", help="time until the targets on a benchmark folder")
     cv.add_argument("--benchmark", type=Path, required=True, help="folder of scene folders")
     cv.add_argument("--minutes", type=float, default=30.0, help="training limit per building")
