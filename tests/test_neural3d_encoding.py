@@ -6,8 +6,13 @@ import numpy as np
 import pytest
 import torch
 
-from neural3d.field.encoding import (GridEncoding, _FlatGather, gather_rows, positional_encoding,
-                                     scatter_add_rows)
+from neural3d.field.encoding import (
+    GridEncoding,
+    _FlatGather,
+    gather_rows,
+    positional_encoding,
+    scatter_add_rows,
+)
 
 
 def test_positional_encoding_values():
