@@ -32,15 +32,20 @@ class DefaultBenchmark:
     def folder(self) -> Path:
         return self.root / self.preset
 
-    def announce(self, methods: tuple[str, ...], neural3d_steps: int) -> str:
-        """The line printed before the default run starts."""
+    def announce(self, methods: tuple[str, ...], neural3d_steps: int,
+                 comparisons: int = 1) -> str:
+        """The line printed before the default run starts; ``comparisons`` > 1 for a study
+        that repeats the default comparison (with every method) that many times."""
         made = "cached" if self.folder.is_dir() else "to be generated"
+        repeated = (f", {comparisons} comparisons (clean and degraded inputs)"
+                    if comparisons > 1 else "")
         return (
             f"Built-in default: the '{self.preset}' benchmark ({made} in {self.folder}, "
             f"{self.resolution} px, {self.views} orbit views), methods {', '.join(methods)}"
             + (f", neural3d {neural3d_steps} training steps per building" if "neural3d" in methods
                else "")
-            + f". This takes up to about {self.expected_minutes:g} minutes on 2 CPU cores."
+            + f"{repeated}. This takes up to about {self.expected_minutes * comparisons:g} "
+            f"minutes on 2 CPU cores."
         )
 
 

@@ -271,17 +271,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         configs = {"neural3d": neural3d_config(args, default)}
         if args.explain:
             return _explain(args, default, methods, views, configs)
+        study = (RobustnessStudy(seed=args.degrade_seed, heavy_levels=args.robustness_neural3d)
+                 if args.robustness else None)
         if default is not None:
-            print(default.announce(methods, configs["neural3d"].steps), flush=True)
+            print(default.announce(methods, configs["neural3d"].steps,
+                                   study.heavy_comparisons if study else 1), flush=True)
         data = (ensure_benchmark(default) if default is not None else args.data).resolve()
         results = args.results or data.with_name(f"{data.name}-results")
         out = args.out or data.with_name(f"{data.name}-compare")
         check_output_folder(results, "--results")
         check_output_folder(out, "--out")
-        if args.robustness:
+        if study is not None:
             configs = study_config(configs)
-            study = RobustnessStudy(seed=args.degrade_seed,
-                                    heavy_levels=args.robustness_neural3d)
             rows = run_study(data, results / "robustness", out / "robustness",
                              lambda r: method_specs(methods, views, r, configs=configs), study,
                              compare)

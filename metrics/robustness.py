@@ -54,6 +54,13 @@ class RobustnessStudy:
             for s in severities:
                 DegradeSpec(name, s, self.seed)  # type: ignore[arg-type]
 
+    @property
+    def heavy_comparisons(self) -> int:
+        """How many comparisons run the heavy methods: the clean one and each degraded one."""
+        if self.heavy_levels == "max":
+            return 1 + len(self.levels)
+        return 1 + sum(len(severities) for _, severities in self.levels)
+
 
 def run_study(
     data: Path, results: Path, out: Path, specs_for: SpecsFor, study: RobustnessStudy,

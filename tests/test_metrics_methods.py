@@ -6,6 +6,7 @@ import pytest
 
 from metrics.benchmark_cache import DefaultBenchmark
 from metrics.methods import method_specs
+from metrics.robustness import RobustnessStudy
 from neural3d.method import Neural3dBudget
 
 
@@ -65,3 +66,9 @@ def test_default_benchmark_announces_what_it_does(tmp_path):
     assert "neural3d 1000 training steps per building" in line
     assert f"about {default.expected_minutes:g} minutes on 2 CPU cores" in line
     assert "neural3d" not in default.announce(("2D-S",), 1000).split("methods")[1]
+    study = RobustnessStudy()  # clean + one neural3d comparison per degradation
+    assert study.heavy_comparisons == 5
+    assert RobustnessStudy(heavy_levels="all").heavy_comparisons == 13
+    line = default.announce(("2D-S", "neural3d"), 1000, study.heavy_comparisons)
+    assert "5 comparisons" in line
+    assert f"about {5 * default.expected_minutes:g} minutes" in line
