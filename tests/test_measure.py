@@ -147,9 +147,25 @@ def test_projected_counts_recesses_and_underside_once():
     for facade in m.facades:
         assert facade.window_area_m2 == pytest.approx(2.4, abs=0.25)
     # counting every triangle adds the reveals (8 x 4.4 m x 0.3 m) and the 24 m² underside
-    every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(count="all"))
+    every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
+        count="all", visibility_rays_per_sample=0))
     assert every.window_area_m2 > m.window_area_m2 + 0.8 * 8 * 4.4 * 0.3
     assert every.facade_area_m2 > m.facade_area_m2 + 0.9 * 24.0
+
+
+def test_surfaces_inside_the_building_count_for_nothing():
+    """A closed cavity inside the 6 x 4 x 10 m box (a blob a field may leave behind the
+    windows): its 2 x (4 + 2) x 6 = 72 m² of walls are hidden from outside."""
+    def sdf(p):
+        return np.maximum(box_sdf(p, [-3, -2, 0], [3, 2, 10]), -box_sdf(p, [-2, -1, 2], [2, 1, 8]))
+
+    v, f, labels = _semantic_mesh(sdf, [-4, -3, -1], [4, 3, 11], (3.0, 6.0), 0.1)
+    seen = measure_semantic_mesh(v, f, labels)
+    assert seen.facade_area_m2 == pytest.approx(200.0, rel=0.01)
+    assert seen.wwr == pytest.approx(0.3, abs=0.01)
+    assert seen.ungrouped_facade_area_m2 < 1.0
+    every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(visibility_rays_per_sample=0))
+    assert every.facade_area_m2 > seen.facade_area_m2 + 0.9 * 72.0
 
 
 def test_mesh_without_facade_classes_has_no_wwr():
@@ -172,7 +188,8 @@ def test_bad_inputs(labels, faces, message):
 @pytest.mark.parametrize("kwargs", [
     {"count": "some"}, {"facade_max_tilt_deg": 90.0}, {"azimuth_bin_deg": 0.0},
     {"min_facade_separation_deg": 0.0}, {"plane_gap_m": -1.0}, {"plane_slab_m": -0.1},
-    {"plane_max_angle_deg": 90.0}, {"curve_strip_m": 0.0},
+    {"plane_max_angle_deg": 90.0}, {"curve_strip_m": 0.0}, {"visibility_rays_per_sample": -1},
+    {"min_escape_fraction": 0.0},
 ])
 def test_bad_config(kwargs):
     with pytest.raises(ValueError, match=next(iter(kwargs))):

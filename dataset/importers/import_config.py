@@ -11,6 +11,7 @@ import argparse
 from dataclasses import dataclass, fields
 
 from dataset.importers.mesh_files import UpAxis
+from dataset.rendering.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
 
 
 @dataclass(frozen=True)
@@ -37,9 +38,9 @@ class ImportConfig:
     """Narrower groups (window reveals, pilaster sides) belong to no facade."""
     rays_per_sample: int = 16
     """Ray directions per sample point (4 points per face) for the visibility test."""
-    min_escape_fraction: float = 0.02
+    min_escape_fraction: float = MIN_ESCAPE_FRACTION
     """A face is seen from outside if at least this fraction of its rays escape."""
-    ray_offset_m: float = 1e-3
+    ray_offset_m: float = RAY_OFFSET_M
     """Rays start this far off the surface (embree works in float32)."""
     footprint_height_m: float = 0.05
     """The footprint is the cross-section this far above the ground."""

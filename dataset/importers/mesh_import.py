@@ -33,7 +33,7 @@ from dataset.importers.import_config import (
 from dataset.importers.mesh_files import merge_vertices, read_labelled_mesh_file
 from dataset.rendering.raycast import Raycaster
 from dataset.rendering.section import cross_section_footprint
-from dataset.rendering.visibility import escape_fractions
+from dataset.rendering.visibility import seen_from_outside
 
 CURVED_SPREAD_DEG = 1.0  # a facade whose face normals spread wider than this is curved
 
@@ -210,14 +210,11 @@ def _facade_candidates(mesh: LabelledMesh, grade_z_m: float) -> np.ndarray:
 def _seen_from_outside(raycaster: Raycaster, which: np.ndarray, config: ImportConfig
                        ) -> np.ndarray:
     """(F,) bool: faces in ``which`` that enough rays leave
-    (:mod:`dataset.rendering.visibility`)."""
-    seen = np.zeros(len(which), dtype=bool)
-    if which.any():
-        seen[which] = escape_fractions(
-            raycaster, raycaster.mesh.triangles_m[which], raycaster.face_normals[which],
-            rays_per_sample=config.rays_per_sample, offset_m=config.ray_offset_m, ground=True,
-        ) >= config.min_escape_fraction
-    return seen
+    (:func:`dataset.rendering.visibility.seen_from_outside`)."""
+    return seen_from_outside(raycaster, which, rays_per_sample=config.rays_per_sample,
+                             offset_m=config.ray_offset_m,
+                             min_escape_fraction=config.min_escape_fraction, ground=True,
+                             show_progress=True)
 
 
 def _drop_collapsed_faces(mesh: LabelledMesh) -> tuple[LabelledMesh, np.ndarray]:

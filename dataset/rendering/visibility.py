@@ -31,6 +31,10 @@ SAMPLE_BARYCENTRIC = np.array(
 They keep 0.2 of the way from every edge, so that a ray from a face in an inside corner
 starts clear of the neighbouring face.
 """
+MIN_ESCAPE_FRACTION = 0.02
+"""A face is seen from outside when at least this fraction of its rays escape (one in 50)."""
+RAY_OFFSET_M = 1e-3
+"""Rays start this far off the surface (embree works in float32)."""
 MIN_RAY_COSINE = 0.1  # no ray within ~6 deg of the face plane: it would graze coplanar neighbours
 RAYS_PER_BATCH = 1 << 20  # bounds memory: ~100 MB of float64 per batch
 
@@ -109,6 +113,29 @@ def escape_fractions(
         escaped[lo:hi] = 1.0 - hit.reshape(hi - lo, -1).mean(axis=1)
     result[valid] = escaped
     return result
+
+
+def seen_from_outside(
+    raycaster: Raycaster,
+    which: np.ndarray,
+    *,
+    rays_per_sample: int,
+    offset_m: float,
+    min_escape_fraction: float,
+    ground: bool = True,
+    show_progress: bool = False,
+) -> np.ndarray:
+    """(F,) bool over the raycaster's mesh: faces in ``which`` ((F,) bool) whose escape
+    fraction (:func:`escape_fractions`) is at least ``min_escape_fraction``; False elsewhere."""
+    mesh = raycaster.mesh
+    seen = np.zeros(len(mesh.faces), dtype=bool)
+    if which.any():
+        seen[which] = escape_fractions(
+            raycaster, mesh.triangles_m[which], raycaster.face_normals[which],
+            rays_per_sample=rays_per_sample, offset_m=offset_m, ground=ground,
+            show_progress=show_progress,
+        ) >= min_escape_fraction
+    return seen
 
 
 def _to_world(local: np.ndarray, normals: np.ndarray) -> np.ndarray:

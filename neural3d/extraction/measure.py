@@ -5,6 +5,11 @@ fraction of its three vertices in each class (a triangle with two window
 vertices and one wall vertex gives 2/3 of its area to window, 1/3 to wall).
 Gross facade = wall + window + door; roof, other and background never count.
 
+Only faces seen from outside count (``MeasureConfig.visibility_rays_per_sample``
+> 0, :func:`dataset.rendering.visibility.seen_from_outside`: some ray from the
+face leaves the mesh): a surface a trained field closes inside the building (a
+blob behind the windows, the sides of a tunnel at the door) has no area.
+
 Facades are found without ground truth, from the horizontal direction of the
 facade triangles' normals:
 
@@ -54,6 +59,8 @@ from scipy.ndimage import gaussian_filter1d
 from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
 from dataset.core.mesh import triangle_areas_m2, triangle_normals
 from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.rendering.raycast import Raycaster
+from dataset.rendering.visibility import seen_from_outside
 from neural3d.extraction.facade_planes import (
     azimuth_offset,
     circular_mean_deg,
@@ -194,6 +201,11 @@ def measure_semantic_mesh(
     areas = class_area_m2(vertices_m, faces, labels)
     facade_classes = list(FACADE_CLASSES)
     facade_area = areas[:, facade_classes].sum(axis=1)
+    if config.visibility_rays_per_sample > 0:
+        hidden = (facade_area > 0) & ~_seen_from_outside(vertices_m, faces, facade_area > 0,
+                                                        config)
+        areas[hidden] = 0.0
+        facade_area[hidden] = 0.0
     group = _group_faces(vertices_m, faces, facade_area, config)
     if config.count == "projected":
         planes = project_onto_facade_planes(vertices_m, faces, facade_area, group, config=config)
@@ -219,6 +231,15 @@ def measure_semantic_mesh(
         facades=facades,
         ungrouped_facade_area_m2=ungrouped,
     )
+
+
+def _seen_from_outside(vertices_m: np.ndarray, faces: np.ndarray, which: np.ndarray,
+                       config: MeasureConfig) -> np.ndarray:
+    """(F,) bool: faces in ``which`` that some ray from them leaves without a hit."""
+    return seen_from_outside(Raycaster.from_triangles(vertices_m, faces), which,
+                             rays_per_sample=config.visibility_rays_per_sample,
+                             offset_m=config.ray_offset_m,
+                             min_escape_fraction=config.min_escape_fraction, ground=True)
 
 
 def _facade_figures(

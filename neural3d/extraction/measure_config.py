@@ -6,6 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from dataset.rendering.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
+
 
 @dataclass(frozen=True)
 class MeasureConfig:
@@ -15,6 +17,10 @@ class MeasureConfig:
     facade plane (robust to the wavy walls, recesses and undersides of a neural
     field's mesh); ``count="all"`` sums the classes over every triangle (the
     paper); ``count="grouped"`` only over triangles in a kept facade group.
+
+    Only faces seen from outside count (``visibility_rays_per_sample`` > 0): a
+    trained field may close surfaces inside the building (a blob behind the
+    windows, the sides of a tunnel at a door), which no facade holds.
     """
 
     count: Literal["projected", "all", "grouped"] = "projected"
@@ -29,6 +35,11 @@ class MeasureConfig:
     plane_slab_m: float = 0.4
     plane_max_angle_deg: float = 60.0
     curve_strip_m: float = 1.0  # wider than a window recess, narrow enough to follow a curve
+    # seen from outside (dataset.rendering.visibility): 4 points x this many rays per face;
+    # 0 = every face counts
+    visibility_rays_per_sample: int = 4
+    min_escape_fraction: float = MIN_ESCAPE_FRACTION
+    ray_offset_m: float = RAY_OFFSET_M
 
     def __post_init__(self) -> None:
         if self.count not in ("projected", "all", "grouped"):
@@ -48,6 +59,10 @@ class MeasureConfig:
                      "min_facade_area_fraction", "plane_slab_m"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if self.visibility_rays_per_sample < 0 or not 0 < self.min_escape_fraction <= 1:
+            raise ValueError(f"visibility_rays_per_sample must be >= 0 and min_escape_fraction "
+                             f"in (0, 1], got {self.visibility_rays_per_sample}, "
+                             f"{self.min_escape_fraction}")
         if not self.curve_strip_m > 0:
             raise ValueError(f"curve_strip_m must be > 0, got {self.curve_strip_m}")
 
