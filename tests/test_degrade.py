@@ -175,3 +175,30 @@ def test_occluders_cover_facade_pixels_and_label_them_background(box_scene: Path
         assert (after[lost] == SemanticClass.BACKGROUND).all()
         covered += int(lost.sum())
     assert covered > 0
+
+
+def test_depth_holes_are_read_and_the_baselines_run_on_them(box_scene: Path,
+                                                            tmp_path: Path) -> None:
+    """Holes on glass (depth 0) are a sensor's, not a broken scene: every frame's depth
+    reads, 2D-SS runs; depth missing on most of the building is still refused."""
+    from baselines.wwr2dss import run_2dss
+    from dataset.scenes.images import write_depth_m
+    from dataset.scenes.scene_validation import (
+        InvalidSceneError,
+        read_frame_depth_m,
+        read_frame_labels,
+    )
+
+    out = degrade_scene(box_scene, tmp_path / "holes", parse_specs("depth_noise:1"))
+    scene = read_scene(out)
+    holes = 0
+    for frame in scene.frames_in("ideal"):
+        labels = read_frame_labels(scene, frame)
+        depth = read_frame_depth_m(scene, frame, labels)
+        holes += int(((labels == WINDOW) & (depth == 0)).sum())
+    assert holes > 0
+    assert run_2dss(scene, "ideal").wwr is not None
+    frame = scene.frames_in("ideal")[0]
+    write_depth_m(out / frame.depth_file_path, np.zeros((48, 48)), 0.001)
+    with pytest.raises(InvalidSceneError, match="building pixels have no valid depth"):
+        read_frame_depth_m(scene, frame, read_frame_labels(scene, frame))

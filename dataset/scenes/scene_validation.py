@@ -140,10 +140,16 @@ def read_frame_labels(scene: Scene, frame: Frame) -> np.ndarray:
     return labels
 
 
+MAX_DEPTH_HOLE_FRACTION = 0.5
+"""Depth may have holes (0: a sensor's dropouts, glass); more than this share of the
+building's pixels without depth means depth and labels do not belong together."""
+
+
 def read_frame_depth_m(scene: Scene, frame: Frame, labels: np.ndarray | None = None
                        ) -> np.ndarray:
-    """(H, W) float32 z-depth (m) of ``frame``, checked: finite, >= 0, and > 0 where
-    ``labels`` (if given) show anything but the scene's background class.
+    """(H, W) float32 z-depth (m) of ``frame``, checked: finite, >= 0, and > 0 on at least
+    half (:data:`MAX_DEPTH_HOLE_FRACTION`) of the pixels where ``labels`` (if given) show
+    anything but the scene's background class; 0 is a hole (no depth).
 
     Raises
     ------
@@ -159,15 +165,20 @@ def read_frame_depth_m(scene: Scene, frame: Frame, labels: np.ndarray | None = N
     depth = read_depth_m(path, scene.depth_unit_scale_factor)
     _check_shape(depth, frame, frame.depth_file_path)
     bad = ~np.isfinite(depth) | (depth < 0)
+    if bad.any():
+        raise InvalidSceneError(
+            f"{path}: {int(bad.sum())} pixels have negative or non-finite depth; write 0 where "
+            "there is no depth")
     if labels is not None:
         names = [n.lower() for n in scene.semantic_classes]
         background = names.index("background") if "background" in names else 0
-        bad |= (labels != background) & (depth <= 0)
-    if bad.any():
-        raise InvalidSceneError(
-            f"{path}: {int(bad.sum())} building pixels have no valid depth (zero, negative or "
-            "not finite) where the semantic mask shows the building; depth and labels must "
-            "come from the same view")
+        building = labels != background
+        holes = building & (depth <= 0)
+        if holes.sum() > MAX_DEPTH_HOLE_FRACTION * max(int(building.sum()), 1):
+            raise InvalidSceneError(
+                f"{path}: {int(holes.sum())} of {int(building.sum())} building pixels have no "
+                "valid depth (zero) where the semantic mask shows the building; depth and "
+                "labels must come from the same view")
     return depth
 
 
