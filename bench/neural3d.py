@@ -79,10 +79,11 @@ def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.de
         if device.type == "cuda":
             torch.cuda.synchronize(device)
 
-    for i in range(max(warmup, 1)):  # allocator, first calls, the grid's first refreshes
+    warmup = max(warmup, 1)  # allocator, first calls, the grid's first refreshes
+    for i in range(warmup):
         step(i)
     wall, cpu = time.perf_counter(), time.process_time()
-    for i in range(max(warmup, 1), max(warmup, 1) + steps):
+    for i in range(warmup, warmup + steps):
         step(i)
     return steps / (time.perf_counter() - wall), steps / (time.process_time() - cpu)
 

@@ -202,8 +202,8 @@ def measure_semantic_mesh(
     facade_classes = list(FACADE_CLASSES)
     facade_area = areas[:, facade_classes].sum(axis=1)
     if config.visibility_rays_per_sample > 0:
-        hidden = (facade_area > 0) & ~_seen_from_outside(vertices_m, faces, facade_area > 0,
-                                                        config)
+        facade = facade_area > 0
+        hidden = facade & ~_seen_from_outside(vertices_m, faces, facade, config)
         areas[hidden] = 0.0
         facade_area[hidden] = 0.0
     group = _group_faces(vertices_m, faces, facade_area, config)

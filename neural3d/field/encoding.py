@@ -52,7 +52,8 @@ def gather_rows(table: Tensor, index: Tensor) -> Tensor:
 
 
 def scatter_add_rows(grad: Tensor, index: Tensor, rows: int) -> Tensor:
-    """Inverse of :func:`gather_rows`: "(*index, F)" -> "(rows, F)", sums per row.
+    """Adjoint of :func:`gather_rows` (its backward): "(*index, F)" -> "(rows, F)", the
+    sum of the values gathered from each row.
 
     A ``bincount`` per feature (accumulated in float64, then cast back), which
     on CPU is about 3x faster than ``index_add_`` on the rows.
