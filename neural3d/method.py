@@ -8,6 +8,7 @@ Training (and torch) is imported only when a run is needed.
 
 from __future__ import annotations
 
+import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
@@ -15,7 +16,7 @@ from typing import Any, Literal
 from dataset.core.method import Method
 from dataset.core.protocols import TRAIN_PROTOCOL
 from dataset.core.results import MethodResult
-from dataset.core.scene_record import Scene
+from dataset.core.scene_record import Scene, scene_name
 from neural3d.config import TrainConfig, config_to_dict, preset_config
 from neural3d.extraction.extract_config import ExtractConfig
 
@@ -97,7 +98,13 @@ def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
     """Train for ``budget.steps`` steps (``neural3d.train``) into ``artefacts_dir / <scene>``,
     then extract (``neural3d.extract``) into its ``extract`` folder.
 
-    The result records the steps trained and whether the time cap cut training short.
+    A run folder already there with the same training provenance
+    (:func:`neural3d.training.run_folder.training_provenance`: training code, config,
+    scene, device, threads, libraries) is not trained again: a finished one is only
+    extracted again (after a change to meshing or measuring), a partial one (a comparison
+    stopped mid-building) is resumed. The result records the steps trained, whether the
+    time cap cut training short, and, when training was reused, says so in ``warnings``
+    with ``wall_time_s`` = the stored training and evaluation seconds + this extraction.
     """
     import torch
 
@@ -105,19 +112,32 @@ def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
     from neural3d.extract import extract_run  # noqa: I001
     from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
     from neural3d.train import train
+    from neural3d.training.run_folder import prior_run, training_provenance
 
     config = train_config(budget)
     torch.set_num_threads(budget.threads)
     device = torch.device(budget.device)
-    run_dir = train(scene.root, config, artefacts_dir, device=device,
-                    max_seconds=budget.max_minutes * 60.0)
+    run_dir = Path(artefacts_dir) / scene_name(scene.root)
+    prior = prior_run(run_dir, training_provenance(scene.root, config, device),
+                      config.iterations)
+    if prior != "finished":
+        run_dir = train(scene.root, config, artefacts_dir, device=device,
+                        resume=prior == "partial", max_seconds=budget.max_minutes * 60.0)
     state = read_checkpoint(run_dir / CHECKPOINT_NAME, torch.device("cpu"))
     steps = int(state["step"])
+    tic = time.perf_counter()
     result = extract_run(run_dir, config=extract_config(budget), device=device,
                          out_dir=run_dir / EXTRACT_FOLDER)
+    reused = ()
+    wall_time_s = 0.0  # the runner times the whole run
+    if prior == "finished":
+        trained_s = float(state["train_s"]) + float(state.get("eval_s", 0.0))
+        reused = (f"training reused: {run_dir} was trained earlier with the same training "
+                  f"code, config and scene ({trained_s:.0f} s); only extraction ran",)
+        wall_time_s = trained_s + time.perf_counter() - tic
     return replace(result, config={**result.config, **_budget_record(budget)}, steps=steps,
-                   cut_short=steps < config.iterations,
-                   wall_time_s=0.0)  # the runner times the whole run
+                   cut_short=steps < config.iterations, wall_time_s=wall_time_s,
+                   warnings=result.warnings + reused)
 
 
 def reserve(budget: Neural3dBudget) -> tuple[float, float]:

@@ -10,25 +10,76 @@ import csv
 import io
 import json
 from pathlib import Path
+from typing import Literal
 
 import torch
 
 from dataset.core.atomic import write_json_atomic, write_text_atomic
+from dataset.core.provenance import (
+    Provenance,
+    file_fingerprint,
+    make_provenance,
+    provenance_changes,
+)
 from dataset.core.results import code_version
 from dataset.core.scene_record import scene_name
 from neural3d.config import TrainConfig, config_from_dict, config_to_dict
-from neural3d.field.checkpoint import CHECKPOINT_NAME
+from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
 from neural3d.field.normalisation import Normalisation
+
+TRAINING_CODE = ("dataset", "neural3d.config", "neural3d.field", "neural3d.rendering",
+                 "neural3d.training", "neural3d.train")
+"""The modules whose source a trained field depends on: extraction is not among them, so
+a change to meshing or measuring keeps a finished training (tests/test_neural3d_reuse.py
+checks that ``neural3d.train`` imports nothing of neural3d outside them)."""
+TRAINING_LIBRARIES = ("numpy", "torch")
+PriorRun = Literal["none", "partial", "finished"]
+"""What a run folder holds for a given training provenance: nothing usable, a checkpoint
+before the step budget (resume it), or a finished training (reuse it)."""
 
 LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "depth", "psnr",
               "inv_s", "lr")
+
+
+def training_provenance(scene_dir: Path, config: TrainConfig,
+                        device: torch.device) -> Provenance:
+    """What a training depends on: its config, device and torch thread count (reductions
+    depend on them), the source of :data:`TRAINING_CODE`, the scene's ``transforms.json``
+    and the versions of :data:`TRAINING_LIBRARIES`."""
+    transforms = Path(scene_dir) / "transforms.json"
+    return make_provenance(
+        {"train": config_to_dict(config), "device": str(device),
+         "threads": torch.get_num_threads()},
+        modules=TRAINING_CODE,
+        inputs={"scene": file_fingerprint(transforms) if transforms.is_file() else "absent"},
+        libraries=TRAINING_LIBRARIES)
+
+
+def prior_run(run_dir: Path, expected: Provenance, iterations: int) -> PriorRun:
+    """Whether ``run_dir`` holds a training with provenance ``expected``, and how far it got.
+
+    ``"finished"``: its checkpoint reached ``iterations`` steps; ``"partial"``: an earlier
+    step (a run stopped by Ctrl-C, SIGTERM or a crash after a checkpoint; resuming it
+    matches an uninterrupted run); ``"none"``: no checkpoint, no or another provenance
+    (other training code, config, scene, device, threads or libraries), or a damaged file.
+    """
+    run_dir = Path(run_dir)
+    try:
+        stored = json.loads((run_dir / "run.json").read_text()).get("provenance")
+        if stored is None or provenance_changes(Provenance.from_json_dict(stored), expected):
+            return "none"
+        step = int(read_checkpoint(run_dir / CHECKPOINT_NAME, torch.device("cpu"))["step"])
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        return "none"
+    return "finished" if step >= iterations else "partial"
 
 
 def start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
                      norm: Normalisation, config: TrainConfig, device: torch.device,
                      n_train: int) -> None:
     """Start ``run_dir`` afresh: remove a previous run's checkpoint and logs, write the config
-    and ``run.json`` (scene, classes, background class, normalisation, device, versions)."""
+    and ``run.json`` (scene, classes, background class, normalisation, device, versions and
+    the :func:`training_provenance`)."""
     run_dir.mkdir(parents=True, exist_ok=True)
     for stale in (CHECKPOINT_NAME, "log.csv", "eval.json"):
         (run_dir / stale).unlink(missing_ok=True)
@@ -39,6 +90,7 @@ def start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], b
         "normalisation": norm.to_json_dict(), "device": str(device),
         "code_version": code_version(), "torch_version": torch.__version__,
         "train_frames": n_train,
+        "provenance": training_provenance(scene_dir, config, device).to_json_dict(),
     })
 
 
