@@ -190,20 +190,25 @@ def extract_run(
     device: torch.device,
     out_dir: Path | None = None,
     progress: bool = False,
+    step: int | None = None,
 ) -> MethodResult:
     """Load a trained run, measure it, and write mesh.ply, footprint.geojson and the result JSON.
 
-    ``out_dir`` defaults to ``run_dir / "extract"``. Everything is computed
-    before anything is written, and each file is written atomically.
+    ``out_dir`` defaults to ``run_dir / "extract"`` (``run_dir / "extract" /
+    "step_<step>"`` for a snapshot). ``step``: measure the field as it was at
+    that evaluation step (its snapshot) instead of the checkpoint's. Everything
+    is computed before anything is written, and each file is written atomically.
     """
     from neural3d.field.trained import load_trained_field
 
     run_dir = Path(run_dir)
     if not run_dir.is_dir():
         raise ValueError(f"run folder {run_dir} does not exist")
-    out_dir = Path(out_dir) if out_dir is not None else run_dir / "extract"
+    if out_dir is None:
+        out_dir = run_dir / "extract" if step is None else run_dir / "extract" / f"step_{step}"
+    out_dir = Path(out_dir)
     try:
-        trained = load_trained_field(run_dir, device=device)
+        trained = load_trained_field(run_dir, device=device, step=step)
     except RuntimeError as exc:  # torch's answer to a checkpoint of another code version
         first_line = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ValueError(f"cannot load the run in {run_dir}: {first_line} (was it trained "
@@ -263,6 +268,10 @@ def main(argv: list[str] | None = None) -> int:
                         help="output folder (default: RUN/extract)")
     parser.add_argument("--device", choices=("cpu", "cuda"), default="cpu",
                         help="where to evaluate the field (default cpu)")
+    parser.add_argument("--step", type=int, default=None,
+                        help="measure the field as it was at this evaluation step (its "
+                             "snapshot in RUN/snapshots/) instead of the final one; output "
+                             "to RUN/extract/step_<STEP> unless --out")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
 
@@ -272,7 +281,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.out is not None:
             check_output_folder(args.out)
         result = extract_run(args.run, config=config, device=resolve_device(args.device),
-                             out_dir=args.out, progress=True)
+                             out_dir=args.out, progress=True, step=args.step)
         wwr = "n/a" if result.wwr is None else f"{result.wwr:.3f}"
         facade = "n/a" if result.facade_area_m2 is None else f"{result.facade_area_m2:.1f}"
         window = "n/a" if result.window_area_m2 is None else f"{result.window_area_m2:.1f}"

@@ -31,7 +31,12 @@ from dataset.core.resources import check_training_resources
 from dataset.core.scene_record import scene_name
 from dataset.scenes.scene import read_scene
 from neural3d.config import PRESETS, TrainConfig, preset_config
-from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint, write_checkpoint
+from neural3d.field.checkpoint import (
+    CHECKPOINT_NAME,
+    read_checkpoint,
+    snapshot_path,
+    write_checkpoint,
+)
 from neural3d.field.trained import TrainedField, build_field
 from neural3d.training.data import (
     background_class,
@@ -164,6 +169,8 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             if step % config.checkpoint_every == 0:
                 save()
             if step % config.eval_every == 0 or step == config.iterations or stop:
+                write_checkpoint(snapshot_path(run_dir, step),
+                                 {"step": step, "field": measured.state_dict()})
                 if eval_pixels is not None:
                     tic = time.perf_counter()
                     figures = evaluate(measured, eval_pixels, box_min, box_max, config, step=step,

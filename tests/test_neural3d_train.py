@@ -241,3 +241,20 @@ def test_training_with_ema_checkpoints_and_loads_the_averaged_field(scene, tmp_p
     loaded = load_trained_field(run, device=CPU).field.state_dict()
     assert torch.equal(loaded[table], state["ema"][table])
     assert seen == [state["ema"]["log_inv_s"].item()]  # the callback measured the average
+
+
+def test_each_evaluation_keeps_a_snapshot_of_the_measured_field(short_run):
+    from neural3d.field.checkpoint import snapshot_path, snapshot_steps
+
+    assert snapshot_steps(short_run) == [50, 100]
+    final = read_checkpoint(short_run / "checkpoint.pt", CPU)["field"]
+    last = read_checkpoint(snapshot_path(short_run, 100), CPU)["field"]
+    assert all(torch.equal(final[k], last[k]) for k in final)
+    points = box_surface_points(200)
+    at_end = load_trained_field(short_run, device=CPU)
+    assert torch.equal(load_trained_field(short_run, device=CPU, step=100).sdf_m(points),
+                       at_end.sdf_m(points))
+    halfway = load_trained_field(short_run, device=CPU, step=50).sdf_m(points)
+    assert not torch.equal(halfway, at_end.sdf_m(points))
+    with pytest.raises(ValueError, match=r"no snapshot of step 70; it has \[50, 100\]"):
+        load_trained_field(short_run, device=CPU, step=70)

@@ -1,8 +1,10 @@
-"""Training checkpoints: one ``checkpoint.pt`` per run, written atomically.
+"""Training checkpoints: one ``checkpoint.pt`` per run, written atomically, and snapshots.
 
 It holds only tensors and plain types, so it loads with ``weights_only=True``:
 the step, the field's weights, the optimizer and scheduler states, the random
-generator's state and the training time spent so far.
+generator's state and the training time spent so far. A snapshot
+(``snapshots/step_<step>.pt``, one per evaluation step) holds only the step and
+the measured field's weights, so a run can be measured as it was at each check.
 """
 
 from __future__ import annotations
@@ -16,6 +18,19 @@ import torch
 from dataset.core.atomic import write_bytes_atomic
 
 CHECKPOINT_NAME = "checkpoint.pt"
+SNAPSHOT_FOLDER = "snapshots"
+
+
+def snapshot_path(run_dir: Path, step: int) -> Path:
+    """Where the snapshot of ``step`` lives in a run folder."""
+    return Path(run_dir) / SNAPSHOT_FOLDER / f"step_{step:06d}.pt"
+
+
+def snapshot_steps(run_dir: Path) -> list[int]:
+    """The steps of the snapshots in a run folder, increasing (none: ``[]``)."""
+    folder = Path(run_dir) / SNAPSHOT_FOLDER
+    return sorted(int(p.stem.removeprefix("step_")) for p in folder.glob("step_*.pt")
+                  if p.stem.removeprefix("step_").isdigit())
 
 
 def write_checkpoint(path: Path, state: dict[str, Any]) -> None:

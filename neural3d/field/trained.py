@@ -12,7 +12,7 @@ from torch import Tensor
 from dataset.core.device import resolve_device
 from dataset.core.scene_record import scene_name
 from neural3d.config import FieldConfig, config_from_dict
-from neural3d.field.checkpoint import read_checkpoint
+from neural3d.field.checkpoint import read_checkpoint, snapshot_path, snapshot_steps
 from neural3d.field.chunks import DEFAULT_CHUNK_POINTS
 from neural3d.field.fields import SemanticSDF
 from neural3d.field.normalisation import Normalisation
@@ -83,13 +83,18 @@ def _cat(chunks: list[Tensor], x: Tensor, *trailing: int) -> Tensor:
     return torch.cat(chunks)
 
 
-def load_trained_field(run_dir: Path, *, device: torch.device) -> TrainedField:
+def load_trained_field(run_dir: Path, *, device: torch.device,
+                       step: int | None = None) -> TrainedField:
     """The field of a finished (or checkpointed) run folder, on ``device``.
+
+    ``step``: the field as it was at that evaluation step (its snapshot,
+    :func:`neural3d.field.checkpoint.snapshot_path`) instead of the checkpoint's.
 
     Raises
     ------
     ValueError
-        If the folder lacks ``config.json``, ``run.json`` or ``checkpoint.pt``.
+        If the folder lacks ``config.json``, ``run.json`` or ``checkpoint.pt``, or
+        ``step`` has no snapshot.
     """
     run_dir = Path(run_dir)
     device = resolve_device(device)
@@ -108,7 +113,11 @@ def load_trained_field(run_dir: Path, *, device: torch.device) -> TrainedField:
         raise ValueError(f"{run_dir} holds a damaged config.json or run.json ({exc}); train "
                          "the run again") from exc
     field = build_field(config.model, len(class_names), norm).to(device)
-    state = read_checkpoint(run_dir / "checkpoint.pt", device)
+    if step is not None and not snapshot_path(run_dir, step).is_file():
+        raise ValueError(f"{run_dir} has no snapshot of step {step}; it has "
+                         f"{snapshot_steps(run_dir) or 'none'}")
+    state = read_checkpoint(
+        run_dir / "checkpoint.pt" if step is None else snapshot_path(run_dir, step), device)
     field.load_state_dict(state.get("ema", state["field"]))  # the averaged weights if any
     field.set_step(int(state["step"]))
     field.eval()

@@ -9,6 +9,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import shutil
 from pathlib import Path
 from typing import Literal
 
@@ -24,7 +25,7 @@ from dataset.core.provenance import (
 from dataset.core.results import code_version
 from dataset.core.scene_record import scene_name
 from neural3d.config import TrainConfig, config_from_dict, config_to_dict
-from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
+from neural3d.field.checkpoint import CHECKPOINT_NAME, SNAPSHOT_FOLDER, read_checkpoint
 from neural3d.field.normalisation import Normalisation
 
 TRAINING_CODE = ("dataset", "neural3d.config", "neural3d.field", "neural3d.rendering",
@@ -83,6 +84,7 @@ def start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], b
     run_dir.mkdir(parents=True, exist_ok=True)
     for stale in (CHECKPOINT_NAME, "log.csv", "eval.json"):
         (run_dir / stale).unlink(missing_ok=True)
+    shutil.rmtree(run_dir / SNAPSHOT_FOLDER, ignore_errors=True)
     write_json_atomic(run_dir / "config.json", config_to_dict(config))
     write_json_atomic(run_dir / "run.json", {
         "scene_dir": str(scene_dir.resolve()), "scene_name": scene_name(scene_dir),
