@@ -113,7 +113,7 @@ def test_evaluation_matches_the_own_facades_to_the_truth(scene_dir):
 
 def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
     monkeypatch.setattr(neural3d.field.trained, "load_trained_field",
-                        lambda run_dir, device: AnalyticField(scene_dir))
+                        lambda run_dir, device, step=None: AnalyticField(scene_dir))
     run_dir = tmp_path / "run"
     run_dir.mkdir()
     result = extract_run(run_dir, config=CONFIG, device=torch.device("cpu"))

@@ -41,6 +41,12 @@ How areas are counted (``MeasureConfig.count``):
   curved wall keeps its true area. Facade triangles near no plane count with
   their full area if they are within ``facade_max_tilt_deg`` of vertical (a
   wall curving away from every plane), else not at all.
+  With ``occlusion_cell_m`` > 0 (``"projected"`` only; default 0.1 m), each plane is
+  also probed from in front on a grid (:mod:`neural3d.extraction.occluded_facade`):
+  facade triangles a ray from in front meets first count even where the
+  visibility test below dropped them (the back of a balcony), and facade hidden
+  behind a balcony or another non-facade solid is filled from the nearest seen
+  cells above and below it in its column.
 - ``"all"`` sums the classes over every triangle (the paper);
 - ``"grouped"`` only over triangles in a kept group.
 
@@ -62,12 +68,19 @@ from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 from dataset.rendering.raycast import Raycaster
 from dataset.rendering.visibility import seen_from_outside
 from neural3d.extraction.facade_planes import (
+    FacadePlanes,
     azimuth_offset,
     circular_mean_deg,
     project_onto_facade_planes,
     wrap_deg,
 )
 from neural3d.extraction.measure_config import MeasureConfig
+from neural3d.extraction.occluded_facade import (
+    PlaneProbe,
+    front_seen_faces,
+    occluded_facade_area_m2,
+    probe_planes,
+)
 
 
 @dataclass(frozen=True)
@@ -198,21 +211,41 @@ def measure_semantic_mesh(
         On malformed arrays or class ids outside the known classes.
     """
     vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
-    areas = class_area_m2(vertices_m, faces, labels)
+    shares = class_area_m2(vertices_m, faces, labels)
+    areas = shares.copy()  # the hidden faces' go to 0 below
     facade_classes = list(FACADE_CLASSES)
     facade_area = areas[:, facade_classes].sum(axis=1)
-    if config.visibility_rays_per_sample > 0:
+    occlusion = config.count == "projected" and config.occlusion_cell_m > 0
+    caster = (Raycaster.from_triangles(vertices_m, faces) if len(faces) and (
+        config.visibility_rays_per_sample > 0 or occlusion) else None)
+    if config.visibility_rays_per_sample > 0 and caster is not None:
         facade = facade_area > 0
-        hidden = facade & ~_seen_from_outside(vertices_m, faces, facade, config)
+        hidden = facade & ~_seen_from_outside(caster, facade, config)
         areas[hidden] = 0.0
         facade_area[hidden] = 0.0
     group = _group_faces(vertices_m, faces, facade_area, config)
+    hidden_by_class = np.zeros(NUM_CLASSES)
     if config.count == "projected":
         planes = project_onto_facade_planes(vertices_m, faces, facade_area, group, config=config)
+        behind = np.zeros((len(planes.azimuth_deg), NUM_CLASSES))
+        if occlusion and caster is not None:
+            probes = _probe(caster, shares, planes, config)
+            back = (facade_area == 0) & front_seen_faces(probes, len(faces))
+            if back.any():  # seen from in front, dropped by the hemisphere test: they count
+                areas[back] = shares[back]
+                facade_area = areas[:, facade_classes].sum(axis=1)
+                group = _group_faces(vertices_m, faces, facade_area, config)
+                planes = project_onto_facade_planes(vertices_m, faces, facade_area, group,
+                                                    config=config)
+                probes = _probe(caster, shares, planes, config)
+            behind = occluded_facade_area_m2(
+                caster, shares, planes, probes, cell_m=config.occlusion_cell_m,
+                slab_m=config.plane_slab_m, reach_m=config.occluder_reach_m)
+        hidden_by_class = behind.sum(axis=0)
         counted = areas * (planes.weight.sum(axis=1) + planes.residual)[:, None]
         facades = tuple(
             _facade_figures(k, vertices_m, faces, areas * planes.weight[:, k, None],
-                            planes.weight[:, k] > 0, plane=(az, off))
+                            planes.weight[:, k] > 0, plane=(az, off), behind=behind[k])
             for k, (az, off) in enumerate(zip(planes.azimuth_deg, planes.offset_m)))
         ungrouped = float((areas[:, facade_classes].sum(axis=1) * planes.residual).sum())
     else:
@@ -220,7 +253,7 @@ def measure_semantic_mesh(
         facades = tuple(_facade_figures(i, vertices_m, faces, areas, group == i)
                         for i in range(int(group.max()) + 1))
         ungrouped = float(areas[group < 0][:, facade_classes].sum())
-    window, wall, door = (float(counted[:, c].sum()) for c in
+    window, wall, door = (float(counted[:, c].sum() + hidden_by_class[c]) for c in
                           (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
     return MeshMeasurement(
         window_area_m2=window,
@@ -233,10 +266,16 @@ def measure_semantic_mesh(
     )
 
 
-def _seen_from_outside(vertices_m: np.ndarray, faces: np.ndarray, which: np.ndarray,
+def _probe(caster: Raycaster, shares: np.ndarray, planes: FacadePlanes,
+           config: MeasureConfig) -> list[PlaneProbe | None]:
+    return probe_planes(caster, shares, planes, cell_m=config.occlusion_cell_m,
+                        slab_m=config.plane_slab_m, max_angle_deg=config.plane_max_angle_deg)
+
+
+def _seen_from_outside(caster: Raycaster, which: np.ndarray,
                        config: MeasureConfig) -> np.ndarray:
     """(F,) bool: faces in ``which`` that some ray from them leaves without a hit."""
-    return seen_from_outside(Raycaster.from_triangles(vertices_m, faces), which,
+    return seen_from_outside(caster, which,
                              rays_per_sample=config.visibility_rays_per_sample,
                              offset_m=config.ray_offset_m,
                              min_escape_fraction=config.min_escape_fraction, ground=True)
@@ -244,12 +283,14 @@ def _seen_from_outside(vertices_m: np.ndarray, faces: np.ndarray, which: np.ndar
 
 def _facade_figures(
     index: int, vertices_m: np.ndarray, faces: np.ndarray, areas: np.ndarray, mask: np.ndarray,
-    plane: tuple[float, float] | None = None,
+    plane: tuple[float, float] | None = None, behind: np.ndarray | None = None,
 ) -> MeshFacade:
-    """Figures of the triangles in ``mask``; ``plane`` (azimuth deg, offset m) if known."""
+    """Figures of the triangles in ``mask``; ``plane`` (azimuth deg, offset m) if known;
+    ``behind`` (NUM_CLASSES,) m² hidden behind occluders, added to the classes' areas."""
     tri = vertices_m[faces[mask]]
     a = areas[mask]
-    window, wall, door = (float(a[:, c].sum()) for c in
+    extra = np.zeros(NUM_CLASSES) if behind is None else behind
+    window, wall, door = (float(a[:, c].sum() + extra[c]) for c in
                           (SemanticClass.WINDOW, SemanticClass.WALL, SemanticClass.DOOR))
     weight = a[:, list(FACADE_CLASSES)].sum(axis=1)
     azimuth, offset = plane if plane is not None else azimuth_offset(

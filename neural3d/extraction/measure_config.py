@@ -35,6 +35,10 @@ class MeasureConfig:
     plane_slab_m: float = 0.4
     plane_max_angle_deg: float = 60.0
     curve_strip_m: float = 1.0  # wider than a window recess, narrow enough to follow a curve
+    # facade hidden behind balconies (neural3d.extraction.occluded_facade), "projected" only:
+    # grid cell (0 = off) and how far in front of a plane occluders are looked for
+    occlusion_cell_m: float = 0.1
+    occluder_reach_m: float = 3.0
     # seen from outside (dataset.rendering.visibility): 4 points x this many rays per face;
     # 0 = every face counts
     visibility_rays_per_sample: int = 4
@@ -63,6 +67,9 @@ class MeasureConfig:
             raise ValueError(f"visibility_rays_per_sample must be >= 0 and min_escape_fraction "
                              f"in (0, 1], got {self.visibility_rays_per_sample}, "
                              f"{self.min_escape_fraction}")
+        if self.occlusion_cell_m < 0 or not self.occluder_reach_m > self.plane_slab_m:
+            raise ValueError(f"occlusion_cell_m must be >= 0 and occluder_reach_m > plane_slab_m, "
+                             f"got {self.occlusion_cell_m}, {self.occluder_reach_m}")
         if not self.curve_strip_m > 0:
             raise ValueError(f"curve_strip_m must be > 0, got {self.curve_strip_m}")
 
