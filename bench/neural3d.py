@@ -135,11 +135,11 @@ def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.
         measuring += time.perf_counter() - tic
         checks.append(row)
         print(f"  {scene_dir.name} step {step}: {row}", flush=True)
-        return stop_at_target and _on_target(row)
+        return stop_at_target and on_target(row)
 
     train(scene_dir, config, out_dir, device=device, max_seconds=60.0 * minutes, callback=check)
     return {"scene": scene_dir.name, "family": truth.type if truth else None, "checks": checks,
-            "target_reached": next((c for c in checks if _on_target(c)), None),
+            "target_reached": next((c for c in checks if on_target(c)), None),
             "final": checks[-1] if checks else None, "last3_spread": last_checks_spread(checks)}
 
 
@@ -154,7 +154,7 @@ def last_checks_spread(checks: list[dict], n: int = 3) -> dict[str, float | None
     return {"wwr_ape": spread("wwr_ape"), "footprint_iou": spread("footprint_iou")}
 
 
-def _on_target(row: dict) -> bool:
+def on_target(row: dict) -> bool:
     return (row["wwr_ape"] is not None and row["wwr_ape"] <= WWR_TARGET_PCT
             and row["footprint_iou"] is not None and row["footprint_iou"] >= IOU_TARGET)
 

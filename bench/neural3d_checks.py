@@ -31,6 +31,12 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 
+from bench.neural3d import (  # noqa: E402  the targets and the spread, defined once
+    IOU_TARGET,
+    WWR_TARGET_PCT,
+    last_checks_spread,
+    on_target,
+)
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
@@ -41,10 +47,6 @@ from neural3d.field.checkpoint import snapshot_steps  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
 from neural3d.method import RUNS_FOLDER  # noqa: E402
 from neural3d.training.run_folder import read_evals  # noqa: E402
-
-WWR_TARGET_PCT = 5.0
-IOU_TARGET = 0.96
-SPREAD_CHECKS = 3
 
 
 def run_checks(run_dir: Path, extract: ExtractConfig, last: int | None) -> dict:
@@ -65,23 +67,7 @@ def run_checks(run_dir: Path, extract: ExtractConfig, last: int | None) -> dict:
                      "measure_s": round(time.perf_counter() - tic, 1)})
         print(f"  {run_dir.name} step {step}: {rows[-1]}", file=sys.stderr, flush=True)
     return {"scene": run_dir.name, "family": scene.building.type if scene.building else None,
-            "checks": rows, "last3_spread": spread(rows)}
-
-
-def spread(rows: list[dict], n: int = SPREAD_CHECKS) -> dict[str, float | None]:
-    """Max - min of the WWR error (points of %) and the IoU over the last ``n`` rows."""
-    tail = rows[-n:]
-
-    def of(key: str) -> float | None:
-        values = [r[key] for r in tail if r.get(key) is not None]
-        return max(values) - min(values) if len(values) == n else None
-
-    return {"wwr_ape": of("wwr_ape"), "footprint_iou": of("footprint_iou")}
-
-
-def on_target(row: dict) -> bool:
-    return (row["wwr_ape"] is not None and row["wwr_ape"] <= WWR_TARGET_PCT
-            and row["footprint_iou"] is not None and row["footprint_iou"] >= IOU_TARGET)
+            "checks": rows, "last3_spread": last_checks_spread(rows)}
 
 
 def family_curves(buildings: list[dict]) -> dict[str, list[dict]]:
