@@ -1,7 +1,7 @@
 """neural3d's figures at every check of a comparison's runs: time-to-target and late stability.
 
     python bench/neural3d_checks.py --results DIR [--resolution 256] [--last N]
-        [--scenes NAME ...] [--json FILE] [--plot FILE.png]
+        [--scenes NAME ...] [--json FILE] [--plot FILE.png] [--threads 2]
 
 Reads the run folders a comparison kept (``DIR/neural3d_runs/<scene>/``, DIR
 being ``metrics.compare``'s ``--results``), measures the snapshot of every
@@ -154,13 +154,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--scenes", nargs="*", default=None, help="only these scene names")
     parser.add_argument("--json", type=Path, default=None, help="also write the figures here")
     parser.add_argument("--plot", type=Path, default=None, help="draw the family curves here")
+    parser.add_argument("--threads", type=int, default=2,
+                        help="torch CPU threads (default 2; 1 beside another torch job: two "
+                             "jobs' threads on 2 cores slow both many times over)")
     args = parser.parse_args(argv)
     runs = sorted(p for p in (args.results / RUNS_FOLDER).iterdir()
                   if (p / "run.json").is_file() and (args.scenes is None or p.name in args.scenes))
     if not runs:
         print(f"no neural3d run folder under {args.results / RUNS_FOLDER}", file=sys.stderr)
         return 2
-    torch.set_num_threads(2)
+    torch.set_num_threads(args.threads)
     extract = ExtractConfig(resolution=args.resolution)
     buildings = [run_checks(r, extract, args.last) for r in runs]
     curves = family_curves(buildings)
