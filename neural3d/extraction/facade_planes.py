@@ -136,6 +136,13 @@ def _strip_cosine(normal_xy: np.ndarray, centroid_xy: np.ndarray, weight: np.nda
     return np.maximum(cosine[strip], floor)
 
 
+def plane_frame(azimuth_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """(normal (3,), tangent (3,)): horizontal unit vectors of a facade plane at ``azimuth_deg``
+    (tangent (-N_y, N_x, 0), so u runs counter-clockwise seen from above), world frame."""
+    a = np.radians(azimuth_deg)
+    return np.array([np.cos(a), np.sin(a), 0.0]), np.array([-np.sin(a), np.cos(a), 0.0])
+
+
 def azimuth_offset(
     normal: np.ndarray, centroid_xy: np.ndarray, weight: np.ndarray
 ) -> tuple[float, float]:

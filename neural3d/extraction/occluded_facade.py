@@ -39,7 +39,7 @@ import numpy as np
 
 from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES
 from dataset.rendering.raycast import Raycaster
-from neural3d.extraction.facade_planes import FacadePlanes
+from neural3d.extraction.facade_planes import FacadePlanes, plane_frame
 
 FACADE_IDS = tuple(int(c) for c in FACADE_CLASSES)
 
@@ -84,7 +84,7 @@ def probe_planes(
         if not on_plane.any():
             probes.append(None)
             continue
-        normal, tangent = _frame(azimuth)
+        normal, tangent = plane_frame(azimuth)
         corners = mesh.triangles_m[on_plane].reshape(-1, 3)
         uu, zz = np.meshgrid(_centres(corners @ tangent, cell_m),
                              _centres(corners[:, 2], cell_m), indexing="ij")  # (U, Z)
@@ -125,7 +125,7 @@ def occluded_facade_area_m2(
     for k, probe in enumerate(probes):
         if probe is None:
             continue
-        normal, _ = _frame(planes.azimuth_deg[k])
+        normal, _ = plane_frame(planes.azimuth_deg[k])
         label = np.where(probe.seen, facade_label[np.maximum(probe.face, 0)], -1)
         face, t = raycaster.first_hit(probe.points_m + reach_m * normal,
                                       np.broadcast_to(-normal, probe.points_m.shape))
@@ -135,12 +135,6 @@ def occluded_facade_area_m2(
         filled = _fill_columns(label.reshape(probe.shape), occluded.reshape(probe.shape))
         out[k] = np.bincount(filled[filled >= 0], minlength=NUM_CLASSES) * cell_m ** 2
     return out
-
-
-def _frame(azimuth_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """(normal, tangent): horizontal unit vectors of a plane at ``azimuth_deg``, world frame."""
-    a = np.radians(azimuth_deg)
-    return np.array([np.cos(a), np.sin(a), 0.0]), np.array([-np.sin(a), np.cos(a), 0.0])
 
 
 def _centres(values_m: np.ndarray, cell_m: float) -> np.ndarray:

@@ -23,6 +23,7 @@ import numpy as np
 
 from dataset.core.classes import SemanticClass
 from dataset.core.mesh import triangle_normals
+from neural3d.extraction.facade_planes import plane_frame
 
 SdfFn = Callable[[np.ndarray], np.ndarray]  # (N, 3) world m -> (N,) m, positive outside
 LabelFn = Callable[[np.ndarray], np.ndarray]  # (N, 3) world m -> (N,) dataset class ids
@@ -44,8 +45,7 @@ class PlaneExtent:
 
     def frame(self) -> tuple[np.ndarray, np.ndarray]:
         """(normal (3,), tangent (3,)) unit vectors, world frame."""
-        a = np.radians(self.azimuth_deg)
-        return np.array([np.cos(a), np.sin(a), 0.0]), np.array([-np.sin(a), np.cos(a), 0.0])
+        return plane_frame(self.azimuth_deg)
 
 
 @dataclass(frozen=True)
