@@ -46,9 +46,9 @@ from neural3d.extraction.meshing import (
     SemanticMesh,
     color_vertices,
     extract_mesh,
-    label_vertices,
 )
 from neural3d.extraction.plane_sampling import plane_extents, plane_sampled_areas
+from neural3d.field.chunks import evaluate_in_chunks
 
 METHOD = "neural3d"
 PROTOCOL = TRAIN_PROTOCOL
@@ -63,17 +63,32 @@ def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
     return sdf
 
 
-def field_label_fn(trained, device: torch.device, chunk_points: int) -> LabelFn:
-    """NumPy class-id callable (N, 3) -> (N,) :mod:`dataset.core.classes` ids (semantic-head
-    argmax)."""
+def field_probability_fn(trained, device: torch.device, chunk_points: int):
+    """NumPy callable (N, 3) world m -> (N, NUM_CLASSES) class probabilities of a
+    ``TrainedField``'s semantic head (softmax), in :mod:`dataset.core.classes` id order;
+    classes the run does not know have probability 0."""
     class_ids = _class_ids_of(trained.class_names)
 
-    def label(points_m: np.ndarray) -> np.ndarray:
+    def probabilities(points_m: np.ndarray) -> np.ndarray:
         logits = _batched(lambda p: trained.semantic_logits(p), points_m, device, chunk_points)
         if logits.ndim != 2 or logits.shape[1] != len(class_ids):
             raise ValueError(f"semantic head gave shape {logits.shape}; expected "
                              f"(N, {len(class_ids)}) for classes {trained.class_names}")
-        return class_ids[np.argmax(logits, axis=1)]
+        e = np.exp(logits - logits.max(axis=1, keepdims=True))
+        out = np.zeros((len(logits), NUM_CLASSES), dtype=np.float32)
+        out[:, class_ids] = e / e.sum(axis=1, keepdims=True)
+        return out
+
+    return probabilities
+
+
+def field_label_fn(trained, device: torch.device, chunk_points: int) -> LabelFn:
+    """NumPy class-id callable (N, 3) -> (N,) :mod:`dataset.core.classes` ids (semantic-head
+    argmax)."""
+    probabilities = field_probability_fn(trained, device, chunk_points)
+
+    def label(points_m: np.ndarray) -> np.ndarray:
+        return np.argmax(probabilities(points_m), axis=1)
 
     return label
 
@@ -99,11 +114,13 @@ def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device,
         chunk_points=config.chunk_points,
         min_component_area_fraction=config.min_component_area_fraction, progress=progress,
     )
-    labels = label_vertices(vertices_m, field_label_fn(trained, device, config.chunk_points),
-                            chunk_points=config.chunk_points)
+    probabilities = evaluate_in_chunks(
+        field_probability_fn(trained, device, config.chunk_points), vertices_m,
+        config.chunk_points, out_shape=(NUM_CLASSES,)).astype(np.float32)
+    labels = np.argmax(probabilities, axis=1).astype(np.uint8)
     rgb = color_vertices(vertices_m, faces, field_color_fn(trained, device, config.chunk_points),
                          chunk_points=config.chunk_points)
-    return SemanticMesh(vertices_m, faces, labels, rgb)
+    return SemanticMesh(vertices_m, faces, labels, rgb, probabilities)
 
 
 def measure_field(
@@ -133,8 +150,9 @@ def measure_field(
     start = time.perf_counter()
     device = device if device is not None else getattr(trained, "device", torch.device("cpu"))
     mesh = semantic_mesh_of_field(trained, config, device, progress=progress)
-    m = measure_semantic_mesh(mesh.vertices_m, mesh.faces, mesh.vertex_labels,
-                              config=config.measure)
+    m = measure_semantic_mesh(
+        mesh.vertices_m, mesh.faces, mesh.vertex_labels, config=config.measure,
+        vertex_probabilities=mesh.vertex_probabilities if config.soft_facade_split else None)
     if config.areas == "planes":
         m = with_plane_sampled_areas(m, mesh, trained, config, device)
     warnings: list[str] = []

@@ -44,6 +44,9 @@ class ExtractConfig:
     # whole-building window/wall/door areas: from the mesh's vertex labels, or read from the
     # fields on each facade plane's grid (neural3d.extraction.plane_sampling)
     areas: Literal["mesh", "planes"] = "mesh"
+    # split each mesh triangle's facade area among wall/window/door by the semantic head's
+    # probabilities at its corners, not by their argmax (neural3d.extraction.facade_split)
+    soft_facade_split: bool = True
     plane_cell_m: float = 0.1
     plane_depth_m: float = 0.5  # probed in front of and behind each plane
 

@@ -4,6 +4,9 @@ Areas follow the paper: each triangle's area is shared among classes by the
 fraction of its three vertices in each class (a triangle with two window
 vertices and one wall vertex gives 2/3 of its area to window, 1/3 to wall).
 Gross facade = wall + window + door; roof, other and background never count.
+Given the vertices' class probabilities, the facade part of each triangle is
+then split among wall, window and door by them instead
+(:mod:`neural3d.extraction.facade_split`).
 
 Only faces seen from outside count (``MeasureConfig.visibility_rays_per_sample``
 > 0, :func:`dataset.rendering.visibility.seen_from_outside`: some ray from the
@@ -74,6 +77,7 @@ from neural3d.extraction.facade_planes import (
     project_onto_facade_planes,
     wrap_deg,
 )
+from neural3d.extraction.facade_split import split_facade_area_by_probability
 from neural3d.extraction.measure_config import MeasureConfig
 from neural3d.extraction.occluded_facade import (
     PlaneProbe,
@@ -196,6 +200,7 @@ def measure_semantic_mesh(
     vertex_labels: np.ndarray,
     *,
     config: MeasureConfig = MeasureConfig(),
+    vertex_probabilities: np.ndarray | None = None,
 ) -> MeshMeasurement:
     """Window, wall, door and gross facade areas, WWR and per-facade figures of a semantic mesh.
 
@@ -204,6 +209,9 @@ def measure_semantic_mesh(
     vertices_m : (V, 3) float, world metres (z up)
     faces : (F, 3) int, outward-oriented
     vertex_labels : (V,) int class ids (:mod:`dataset.core.classes`)
+    vertex_probabilities : optional (V, NUM_CLASSES) class probabilities; when given, each
+        triangle's facade area (from the labels) is split among wall, window and door by
+        them (:mod:`neural3d.extraction.facade_split`)
 
     Raises
     ------
@@ -212,6 +220,8 @@ def measure_semantic_mesh(
     """
     vertices_m, faces, labels = _check_inputs(vertices_m, faces, vertex_labels)
     shares = class_area_m2(vertices_m, faces, labels)
+    if vertex_probabilities is not None:
+        shares = split_facade_area_by_probability(shares, faces, vertex_probabilities)
     areas = shares.copy()  # the hidden faces' go to 0 below
     facade_classes = list(FACADE_CLASSES)
     facade_area = areas[:, facade_classes].sum(axis=1)

@@ -42,12 +42,15 @@ class SemanticMesh:
     faces : (F, 3) int64, counter-clockwise seen from outside
     vertex_labels : (V,) uint8 class ids
     vertex_rgb : (V, 3) uint8
+    vertex_probabilities : (V, NUM_CLASSES) float32 class probabilities in
+        :mod:`dataset.core.classes` id order (``vertex_labels`` is their argmax)
     """
 
     vertices_m: np.ndarray
     faces: np.ndarray
     vertex_labels: np.ndarray
     vertex_rgb: np.ndarray
+    vertex_probabilities: np.ndarray
 
 
 def grid_axes_m(
