@@ -52,6 +52,24 @@ def test_courtyard_is_a_hole():
     assert len(_footprint(sdf, min_area_m2=20.0).interiors) == 0
 
 
+def test_roofed_pocket_is_filled_and_courtyard_kept():
+    # a trained field may leave an empty pocket inside the building (no camera sees it):
+    # a 4 x 4 x 3 m void under the roof of a 12 x 12 x 8 m block is no courtyard
+    def pocket(p):
+        return np.maximum(box_sdf(p, [0, 0, 0], [12, 12, 8]), -box_sdf(p, [4, 4, 0.2], [8, 8, 3]))
+
+    def courtyard_and_pocket(p):  # a courtyard open to the sky beside the pocket
+        return np.maximum(pocket(p), -box_sdf(p, [1, 8.5, -1], [3, 10.5, 9]))
+
+    filled = _footprint(pocket)
+    assert isinstance(filled, Polygon) and len(filled.interiors) == 0
+    assert filled.area == pytest.approx(144, rel=0.01)
+    kept = _footprint(courtyard_and_pocket)
+    assert len(kept.interiors) == 1
+    assert Polygon(kept.interiors[0]).area == pytest.approx(4.0, rel=0.02)
+    assert kept.area == pytest.approx(144 - 4, rel=0.01)
+
+
 def test_separate_pieces_and_slivers():
     def sdf(p):
         return np.minimum.reduce([box_sdf(p, [0, 0, 0], [4, 4, 8]),

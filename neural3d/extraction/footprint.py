@@ -11,6 +11,15 @@ that every contour closes, even where the building meets the box edge; the
 zero contours (``skimage.measure.find_contours``, linear interpolation) become
 rings, and nesting is resolved by even-odd (symmetric difference), which keeps
 courtyards as holes. Pieces and holes smaller than ``min_area_m2`` are dropped.
+
+A hole is a courtyard only if it is open to the sky. Nothing constrains a
+trained field inside a building (no camera sees it), so it may leave empty
+pockets there, which the planes cut as holes (one L-shape lost 21 of its
+121 m² to five of them). Each hole is probed along vertical lines from the
+highest plane to the box top, at up to :data:`HOLE_PROBE_LINES` points of a
+``cell_m`` grid at least a cell inside it, one sample per ``cell_m``: a line meets a surface
+where some sample is within half a cell of it (|SDF| <= cell_m / 2, or inside).
+A hole where most lines meet a surface is roofed over and is filled.
 """
 
 from __future__ import annotations
@@ -25,6 +34,7 @@ from neural3d.extraction.meshing import SdfFn, check_box
 from neural3d.field.chunks import DEFAULT_CHUNK_POINTS, evaluate_in_chunks
 
 MAX_FOOTPRINT_CELLS = 4096  # per axis: 16.8 M samples
+HOLE_PROBE_LINES = 64  # vertical lines per footprint hole (open to the sky or roofed over)
 
 
 def sample_sdf_plane(
@@ -115,7 +125,53 @@ def footprint_from_sdf(
     if values.max() <= 0:
         raise ValueError(f"the plane(s) {where} lie wholly inside the surface; the box is "
                          "too small or the field is degenerate")
-    return _polygon_from_grid(values, xs[0], ys[0], cell_m, min_area_m2)
+    polygon = _polygon_from_grid(values, xs[0], ys[0], cell_m, min_area_m2)
+    return fill_roofed_holes(polygon, sdf_fn, z_from_m=max(heights), z_to_m=float(hi[2]),
+                             cell_m=cell_m, chunk_points=chunk_points)
+
+
+def fill_roofed_holes(
+    polygon: Polygon | MultiPolygon, sdf_fn: SdfFn, *, z_from_m: float, z_to_m: float,
+    cell_m: float, chunk_points: int = DEFAULT_CHUNK_POINTS,
+) -> Polygon | MultiPolygon:
+    """``polygon`` (world x/y m) with every hole that a surface roofs over filled.
+
+    A hole is probed along vertical lines from ``z_from_m`` to ``z_to_m`` at up to
+    :data:`HOLE_PROBE_LINES` points of a ``cell_m`` grid at least ``cell_m`` inside
+    it (its representative point if the grid has none), one SDF sample per ``cell_m``; a
+    line meets a surface where a sample is inside or within ``cell_m / 2`` of one.
+    Holes where more than half the lines meet a surface are filled; the others
+    (courtyards open to the sky) stay.
+    """
+    zs = np.arange(z_from_m, z_to_m + 1e-9, cell_m)
+    if len(zs) == 0:
+        return polygon
+    pieces = []
+    for piece in getattr(polygon, "geoms", [polygon]):
+        holes = [ring for ring in piece.interiors
+                 if not _roofed(Polygon(ring), sdf_fn, zs, cell_m, chunk_points)]
+        pieces.append(Polygon(piece.exterior, holes))
+    return pieces[0] if len(pieces) == 1 else MultiPolygon(pieces)
+
+
+def _roofed(hole: Polygon, sdf_fn: SdfFn, zs: np.ndarray, cell_m: float,
+            chunk_points: int) -> bool:
+    from shapely import contains_xy
+
+    x0, y0, x1, y1 = hole.bounds
+    gx, gy = np.meshgrid(np.arange(x0 + cell_m / 2, x1, cell_m),
+                         np.arange(y0 + cell_m / 2, y1, cell_m), indexing="ij")
+    core = hole.buffer(-cell_m)  # a line beside the hole's own wall would meet that wall
+    inside = contains_xy(core, gx.ravel(), gy.ravel())
+    xy = np.column_stack([gx.ravel()[inside], gy.ravel()[inside]])
+    if len(xy) == 0:
+        p = hole.representative_point()
+        xy = np.array([[p.x, p.y]])
+    xy = xy[np.linspace(0, len(xy) - 1, min(len(xy), HOLE_PROBE_LINES)).round().astype(int)]
+    pts = np.concatenate([np.repeat(xy, len(zs), axis=0),
+                          np.tile(zs, len(xy))[:, None]], axis=1)  # (L * Z, 3)
+    sdf = evaluate_in_chunks(sdf_fn, pts, chunk_points).reshape(len(xy), len(zs))
+    return bool(((sdf <= cell_m / 2).any(axis=1)).mean() > 0.5)
 
 
 def _polygon_from_grid(
