@@ -49,6 +49,17 @@ def _quiet(_message):
     pass
 
 
+@contextlib.contextmanager
+def _ctrl_c_raises():
+    """SIGINT raises KeyboardInterrupt in this block, as in a terminal, even where the tests
+    run with SIGINT ignored (a shell's background job: Python then installs no handler)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _attempts(path: Path) -> list[str]:
     return path.read_text().splitlines() if path.is_file() else []
 
@@ -201,7 +212,7 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
             time.sleep(0.05)
 
     threading.Thread(target=interrupt_when_only_the_slow_task_is_left, daemon=True).start()
-    with pytest.raises(KeyboardInterrupt):
+    with _ctrl_c_raises(), pytest.raises(KeyboardInterrupt):
         run_missing(scenes, [quick, slow], results, log=_quiet,
                     execute=make_executor("ray", CONFIG))
     # The interrupt ended the run at once: the slow task (120 s) did not run to its end.
@@ -228,16 +239,22 @@ def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
                "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-steps", "100000",
                "--results", str(results), "--out", str(tmp_path / "out"), "--executor", "ray"]
-    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
-    while not list(results.glob("*.json")) and proc.poll() is None:
-        if time.monotonic() > deadline:
+    # SIGINT as in a terminal, even where this test runs with it ignored (a background job)
+    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        deadline = time.monotonic() + 120
+        while not list(results.glob("*.json")) and proc.poll() is None:
+            if time.monotonic() > deadline:
+                pytest.fail(f"no result appeared: {proc.communicate(timeout=5)[1][-3000:]}")
+            time.sleep(0.1)
+        time.sleep(1.0)
+        proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=60)
+    finally:  # never leave a 100000-step training behind
+        if proc.poll() is None:
             proc.kill()
-            pytest.fail(f"no result appeared: {proc.communicate()[1][-3000:]}")
-        time.sleep(0.1)
-    time.sleep(1.0)
-    proc.send_signal(signal.SIGINT)
-    _, stderr = proc.communicate(timeout=60)
+            proc.communicate()
     assert proc.returncode == 130, stderr
     assert "interrupted" in stderr
     written = sorted(p for p in results.iterdir() if p.is_file())
