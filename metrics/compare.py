@@ -264,8 +264,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         start = time.perf_counter()
         methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
         views = tuple(v.strip() for v in args.views.split(",") if v.strip())
-        if args.executor == "local" or not args.device.startswith("cuda"):
-            resolve_device(args.device)  # a Ray cluster's GPUs are on its nodes, not here
+        # A Ray cluster's GPUs are on its nodes, not here; --no-run and --explain run nothing.
+        runs_here = args.executor == "local" and not (args.no_run or args.explain)
+        resolve_device(args.device, available=runs_here)
         execute = make_executor(args.executor, RayConfig(address=args.ray_address))
         default = DefaultBenchmark() if args.data is None else None
         configs = {"neural3d": neural3d_config(args, default)}

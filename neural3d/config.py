@@ -76,8 +76,9 @@ class TrainConfig:
     occupancy_every: int = 50  # steps between refreshes
     occupancy_margin_cells: float = 1.0  # |sdf| margin beyond the half diagonal, in cells
     # weight averaging: the measured field is an exponential moving average of the trained
-    # one (decay per step; 0 = off); evaluations, callbacks and load_trained_field use it
-    ema_decay: float = 0.0
+    # one (decay per step; 0 = off); evaluations, callbacks and load_trained_field use it.
+    # On in fast: the late checks' WWR spread fell from 5-10 points to ~1 (docs/decisions.md)
+    ema_decay: float = 0.995
     image_scale: float = 1.0  # images are resized by this factor on load
     scene_box_margin: float = 0.1  # fraction of the visual-hull box added on each side
     eval_every: int = 500
@@ -123,7 +124,7 @@ def preset_config(name: PresetName) -> TrainConfig:
                               colour_layers=4, init_inv_s=7.4),
             iterations=100_000, rays_per_batch=2048, lr=5e-4, warmup=5000,
             samples_uniform=64, samples_importance=64, upsample_steps=4,
-            cos_anneal_steps=50_000, mask_weight=0.0,
+            cos_anneal_steps=50_000, mask_weight=0.0, ema_decay=0.0,
             eval_every=5000, checkpoint_every=5000,
         )
     if name == "fast":
@@ -136,6 +137,7 @@ def preset_config(name: PresetName) -> TrainConfig:
                               feature_dim=16, grid_hidden=32),
             iterations=150, rays_per_batch=128, samples_uniform=16, samples_importance=16,
             warmup=10, eval_every=50, checkpoint_every=50, eval_max_frames=2,
+            ema_decay=0.0,  # 150 steps: an average over ~200 would still lean on the start
         )
     raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
 

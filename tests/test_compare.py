@@ -123,7 +123,6 @@ def test_per_facade_rows(compared):
      (["--methods", "2D-S,magic"], "unknown method 'magic'"),
      (["--views", "sideways"], "unknown views 'sideways'"),
      (["--device", "tpu"], "unknown device 'tpu'"),
-     (["--device", "cuda:99"], "torch sees"),
      (["--neural3d-max-minutes", "0"], "neural3d max minutes must be > 0"),
      (["--neural3d-steps", "-3"], "neural3d steps must be >= 1")],
 )
@@ -135,6 +134,23 @@ def test_bad_input_is_one_line_and_exit_code_2(tmp_path, capsys, args, message):
     assert err.startswith("error: ") and message in err and "Traceback" not in err
     assert err.count("\n") == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_a_device_that_is_not_here_is_refused_when_something_would_run(tmp_path, capsys):
+    data, _ = make_benchmark(tmp_path)
+    assert main(["--data", str(data), "--device", "cuda:99", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "torch sees" in err and err.count("\n") == 1
+
+
+def test_no_run_reads_results_of_a_device_that_is_not_here(tmp_path):
+    """Results made on a GPU machine are read and tabled on one without a GPU."""
+    data, results = make_benchmark(tmp_path)
+    argv = ["--data", str(data), "--results", str(results), "--out", str(tmp_path / "o"),
+            "--no-run", "--device", "cuda:99"]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(argv) == 0
+    assert (tmp_path / "o" / "table2_errors.md").is_file()
 
 
 def test_runs_the_2d_methods_on_the_tiny_benchmark_then_reuses_them(tiny_benchmark, tmp_path):
