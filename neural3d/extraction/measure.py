@@ -49,7 +49,9 @@ How areas are counted (``MeasureConfig.count``):
   facade triangles a ray from in front meets first count even where the
   visibility test below dropped them (the back of a balcony), and facade hidden
   behind a balcony or another non-facade solid is filled from the nearest seen
-  cells above and below it in its column.
+  cells above and below it in its column; and where two walls meet in a concave
+  corner that the field filled (``corner_max_gap_m`` > 0), each wall's rows are
+  continued to the corner line (:mod:`neural3d.extraction.concave_corners`).
 - ``"all"`` sums the classes over every triangle (the paper);
 - ``"grouped"`` only over triangles in a kept group.
 
@@ -70,6 +72,7 @@ from dataset.core.mesh import triangle_areas_m2, triangle_normals
 from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 from dataset.rendering.raycast import Raycaster
 from dataset.rendering.visibility import seen_from_outside
+from neural3d.extraction.concave_corners import concave_corner_fill
 from neural3d.extraction.facade_planes import (
     FacadePlanes,
     azimuth_offset,
@@ -83,6 +86,7 @@ from neural3d.extraction.occluded_facade import (
     PlaneProbe,
     front_seen_faces,
     occluded_facade_area_m2,
+    occluded_facade_labels,
     probe_planes,
 )
 
@@ -248,9 +252,16 @@ def measure_semantic_mesh(
                 planes = project_onto_facade_planes(vertices_m, faces, facade_area, group,
                                                     config=config)
                 probes = _probe(caster, shares, planes, config)
-            behind = occluded_facade_area_m2(
-                caster, shares, planes, probes, cell_m=config.occlusion_cell_m,
-                slab_m=config.plane_slab_m, reach_m=config.occluder_reach_m)
+            labels = occluded_facade_labels(caster, shares, planes, probes,
+                                            slab_m=config.plane_slab_m,
+                                            reach_m=config.occluder_reach_m)
+            behind = occluded_facade_area_m2(probes, labels, cell_m=config.occlusion_cell_m)
+            corners = concave_corner_fill(caster, planes, probes, labels,
+                                          cell_m=config.occlusion_cell_m,
+                                          reach_m=config.occluder_reach_m,
+                                          max_gap_m=config.corner_max_gap_m,
+                                          strip_m=config.curve_strip_m)
+            behind, planes = behind + corners.area_m2, corners.planes
         hidden_by_class = behind.sum(axis=0)
         counted = areas * (planes.weight.sum(axis=1) + planes.residual)[:, None]
         facades = tuple(

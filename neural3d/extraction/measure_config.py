@@ -39,6 +39,9 @@ class MeasureConfig:
     # grid cell (0 = off) and how far in front of a plane occluders are looked for
     occlusion_cell_m: float = 0.1
     occluder_reach_m: float = 3.0
+    # a concave corner the field filled (neural3d.extraction.concave_corners), with occlusion:
+    # the longest run of a wall's row continued to the corner line (0 = off)
+    corner_max_gap_m: float = 1.5
     # seen from outside (dataset.rendering.visibility): 4 points x this many rays per face;
     # 0 = every face counts
     visibility_rays_per_sample: int = 4
@@ -60,7 +63,7 @@ class MeasureConfig:
             raise ValueError("min_facade_separation_deg must be in (0, 180], got "
                              f"{self.min_facade_separation_deg}")
         for name in ("azimuth_smoothing_deg", "plane_gap_m", "min_facade_area_m2",
-                     "min_facade_area_fraction", "plane_slab_m"):
+                     "min_facade_area_fraction", "plane_slab_m", "corner_max_gap_m"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
         if self.visibility_rays_per_sample < 0 or not 0 < self.min_escape_fraction <= 1:

@@ -23,7 +23,8 @@ triangles is probed with rays along the plane's inward normal:
 
 In each column (fixed u), a run of unseen cells with a seen cell right above it
 and a seen cell or the ground (the grid's bottom) right below, at least half of
-whose cells are occluded, is filled (:func:`occluded_facade_area_m2`): each cell
+whose cells are occluded, is filled (:func:`occluded_facade_labels`,
+:func:`occluded_facade_area_m2`): each cell
 takes the class of the nearest seen cell in the column (the one above on a tie;
 the one above only, at the ground), and its area is added to that plane's
 figures. Under a balcony door the upper half of the hole then continues the door
@@ -110,20 +111,24 @@ def front_seen_faces(probes: list[PlaneProbe | None], face_count: int) -> np.nda
     return seen
 
 
-def occluded_facade_area_m2(
+def occluded_facade_labels(
     raycaster: Raycaster, class_area_m2: np.ndarray, planes: FacadePlanes,
-    probes: list[PlaneProbe | None], *, cell_m: float, slab_m: float, reach_m: float,
-) -> np.ndarray:
-    """Facade area (m²) hidden behind occluders on each plane, by class (module docstring).
+    probes: list[PlaneProbe | None], *, slab_m: float, reach_m: float,
+) -> list[np.ndarray | None]:
+    """Per plane, the (U, Z) class each cell of its probe grid takes: the seen triangle's
+    largest facade class, or, for facade hidden behind an occluder, the class it is
+    filled with (module docstring); -1 for a cell neither seen nor filled. None where
+    ``probes`` has none.
 
-    ``probes`` from :func:`probe_planes` on the same planes and ``cell_m``; ``reach_m``:
-    how far in front of a plane occluders are looked for. Returns (K, NUM_CLASSES) m².
+    ``probes`` from :func:`probe_planes` on the same planes; ``reach_m``: how far in
+    front of a plane occluders are looked for.
     """
-    out = np.zeros((len(planes.azimuth_deg), NUM_CLASSES))
     occluder = ~np.isin(np.argmax(class_area_m2, axis=1), FACADE_IDS)  # (F,)
     facade_label = np.array(FACADE_IDS)[np.argmax(class_area_m2[:, list(FACADE_IDS)], axis=1)]
+    out: list[np.ndarray | None] = []
     for k, probe in enumerate(probes):
         if probe is None:
+            out.append(None)
             continue
         normal, _ = plane_frame(planes.azimuth_deg[k])
         label = np.where(probe.seen, facade_label[np.maximum(probe.face, 0)], -1)
@@ -132,8 +137,22 @@ def occluded_facade_area_m2(
         hit = face >= 0
         occluded = np.zeros(len(face), dtype=bool)
         occluded[hit] = occluder[face[hit]] & (t[hit] < reach_m - slab_m)
-        filled = _fill_columns(label.reshape(probe.shape), occluded.reshape(probe.shape))
-        out[k] = np.bincount(filled[filled >= 0], minlength=NUM_CLASSES) * cell_m ** 2
+        seen = label.reshape(probe.shape)
+        filled = _fill_columns(seen, occluded.reshape(probe.shape))
+        out.append(np.where(seen >= 0, seen, filled))
+    return out
+
+
+def occluded_facade_area_m2(probes: list[PlaneProbe | None],
+                            labels: list[np.ndarray | None], *, cell_m: float) -> np.ndarray:
+    """Facade area (m²) hidden behind occluders on each plane, by class: the filled cells
+    of :func:`occluded_facade_labels` (``labels``) on the ``cell_m`` grids of ``probes``.
+    Returns (K, NUM_CLASSES) m²."""
+    out = np.zeros((len(probes), NUM_CLASSES))
+    for k, (probe, label) in enumerate(zip(probes, labels)):
+        if probe is not None:
+            filled = label[~probe.seen.reshape(probe.shape)]
+            out[k] = np.bincount(filled[filled >= 0], minlength=NUM_CLASSES) * cell_m ** 2
     return out
 
 
