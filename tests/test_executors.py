@@ -243,10 +243,11 @@ def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + 300  # Ray's start and 2D-S on a busy 2-core machine
         while not list(results.glob("*.json")) and proc.poll() is None:
             if time.monotonic() > deadline:
-                pytest.fail(f"no result appeared: {proc.communicate(timeout=5)[1][-3000:]}")
+                proc.kill()
+                pytest.fail(f"no result appeared in 300 s: {proc.communicate()[1][-3000:]}")
             time.sleep(0.1)
         time.sleep(1.0)
         proc.send_signal(signal.SIGINT)
