@@ -26,7 +26,7 @@ class DefaultBenchmark:
     neural3d_steps: int = 2000
     neural3d_resolution: int = 128
     neural3d_eval_frames: int = 1
-    expected_minutes: float = 10.0
+    expected_minutes: float = 11.0
 
     @property
     def folder(self) -> Path:
