@@ -6,7 +6,7 @@
 # DATA: a folder of scene folders (e.g. data/paper); RESULTS, OUT: metrics.compare's
 # --results and --out; JOBS: buildings trained at once (default 8); STEPS: the step
 # budget (default 3000); DEVICE: cuda (default; cpu to try the script out). Each building
-# is one `python -m metrics.compare --data DATA/<scene> --methods neural3d --device cuda`
+# is one `python -m metrics.compare --data DATA/<scene> --methods neural3d --device DEVICE`
 # into the shared RESULTS folder (a finished result is reused, as always); then one
 # `--no-run` comparison over DATA writes the tables into OUT.
 #
