@@ -6,7 +6,10 @@ a model; :func:`build_building` turns it into mesh + truth deterministically
 
 - ``paper``: 12 skyscrapers, 12 L-shaped buildings and the four realistic models;
 - ``tiny``: one small building per family (a 9-storey skyscraper, a 4-storey L-shape
-  and the realistic house), cheap to render, for tests and defaults.
+  and the realistic house), cheap to render, for tests and defaults;
+- ``segtrain``: 24 skyscrapers and 24 L-shaped buildings that are never evaluated, the
+  training set of the mask segmenter (``segment/``); no realistic building (its four
+  designs, only jittered, are the evaluated ones).
 
 Run ``python -m dataset.presets`` to print the ranges a preset spans.
 """
@@ -30,7 +33,7 @@ from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_param
 
 Family = Literal["skyscraper", "l_shaped", "realistic"]
 FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic")
-PRESETS = ("paper", "tiny")
+PRESETS = ("paper", "tiny", "segtrain")
 _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 # Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
@@ -45,6 +48,10 @@ _PAPER_SEEDS = {
     "l_shaped": (2000, 2001, 2002, 2003, 2004, 2005, 2006, 2040, 2046, 2060, 2122, 2143),
 }
 _REALISTIC_SEED = 3000
+# Seeds of the segtrain preset: far from every evaluated preset's seeds (and clear of any
+# held-out range near them), so the segmenter never sees a building that is measured.
+_SEGTRAIN_FIRST_SEED = {"skyscraper": 1_000_000, "l_shaped": 2_000_000}
+_SEGTRAIN_PER_FAMILY = 24
 
 
 @dataclass(frozen=True)
@@ -97,6 +104,12 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
             for k, m in enumerate(REALISTIC_MODELS)
         ]
         return tuple(recipes)
+    if name == "segtrain":
+        return tuple(
+            BuildingRecipe(f"segtrain_{family}_{i:02d}", family, first + i)
+            for family, first in _SEGTRAIN_FIRST_SEED.items()
+            for i in range(_SEGTRAIN_PER_FAMILY)
+        )
     raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
 
 

@@ -47,6 +47,7 @@ from metrics.html_report import write_report
 from metrics.mesh_pointers import write_mesh_pointers
 from metrics.methods import list_methods, method_specs
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.predicted_masks import compare_on_predicted_masks
 from metrics.report import (
     per_building_table,
     per_facade_table,
@@ -282,6 +283,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         out = args.out or data.with_name(f"{data.name}-compare")
         check_output_folder(results, "--results")
         check_output_folder(out, "--out")
+        if args.masks:  # the protocol of metrics.predicted_masks
+            if args.degrade or study is not None:
+                raise ValueError("--masks cannot be combined with --degrade or --robustness")
+            print(to_text(compare_on_predicted_masks(
+                args.masks, data, results, out,
+                lambda r: method_specs(methods, views, r, configs=configs), compare,
+                threads=args.masks_threads, allow_run=not args.no_run,
+                reuse_stale=args.reuse_stale, execute=execute,
+                command=" ".join(["python -m metrics.compare", *(argv or sys.argv[1:])]))))
+            return 0
         if study is not None:
             configs = study_config(configs)
             rows = run_study(data, results / "robustness", out / "robustness",

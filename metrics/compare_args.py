@@ -14,6 +14,7 @@ from dataset.degrade.spec import DEGRADATIONS
 from dataset.executors.ray_tasks import add_executor_arguments
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
 from metrics.methods import METHODS
+from metrics.predicted_masks import add_masks_arguments
 from neural3d.method import Neural3dBudget
 
 
@@ -68,6 +69,7 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         "<results>/degraded/, outputs to <out>-<key>")
     parser.add_argument("--degrade-seed", type=int, default=0,
                         help="seed of the degradations (default: 0)")
+    add_masks_arguments(parser)
     parser.add_argument("--robustness", action="store_true",
                         help="run the robustness study (mask noise, occluders, pose and depth "
                         "noise at three severities each; results in <results>/robustness, "
