@@ -52,7 +52,7 @@ class TrainConfig:
     ``max_minutes``: a safety cap; a run it stops is marked ``cut_short``.
     """
 
-    steps: int = 3000
+    steps: int = 2500
     batch: int = 12
     learning_rate: float = 3e-3
     weight_decay: float = 1e-4
@@ -100,6 +100,12 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
         train, val = split_by_building(scenes, config.val_every)
         if not train:
             raise ValueError("no building left to train on; lower --val-every or add scenes")
+        # The record names the code as it was when training started.
+        provenance = make_provenance(
+            asdict(config), modules=("segment", "dataset"),
+            inputs={"scenes": {f"{s.record['folder']}/{s.name}": s.record["transforms"]
+                               for s in train + val}},
+            libraries=("torch", "numpy", "opencv-contrib-python-headless"))
         rng = np.random.default_rng(config.seed)
         torch.manual_seed(config.seed)
         weights = class_weights(train, rng)
@@ -111,6 +117,7 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
         times = {"wall_time_s": round(time.perf_counter() - start, 1),
                  "cpu_time_s": round(time.process_time() - cpu_start, 1)}
         record = _record(config, train, val, weights, best, history, steps_run, times)
+        record["provenance"] = provenance.to_json_dict()
         save_weights(out, model, record)
         return record
     finally:
@@ -184,11 +191,6 @@ def _or_none(value: float) -> float | None:
 def _record(config: TrainConfig, train: list[TrainingScene], val: list[TrainingScene],
             weights: np.ndarray, best: _Best, history: list[dict[str, float]],
             steps_run: int, times: dict[str, float]) -> dict[str, Any]:
-    provenance = make_provenance(
-        asdict(config), modules=("segment", "dataset"),
-        inputs={"scenes": {f"{s.record['folder']}/{s.name}": s.record["transforms"]
-                           for s in train + val}},
-        libraries=("torch", "numpy", "opencv-contrib-python-headless"))
     return {
         "what": "segmenter weights: RGB -> class ids " + ", ".join(
             f"{i} {n}" for i, n in enumerate(CLASS_NAMES)),
@@ -204,7 +206,6 @@ def _record(config: TrainConfig, train: list[TrainingScene], val: list[TrainingS
         "history": history,
         **times,  # CPU time: what the run costs on idle cores, whatever else ran beside it
         "threads": config.threads,
-        "provenance": provenance.to_json_dict(),
     }
 
 

@@ -10,7 +10,7 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
+PACKAGES = ("dataset", "baselines", "neural3d", "segment", "metrics", "figures")
 # Importers that issue 17 works on at the same time as this check was written; their frame
 # splits are converted to dataset.core.protocols' names when both branches meet.
 

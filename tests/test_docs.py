@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
+PACKAGES = ("dataset", "baselines", "neural3d", "segment", "metrics", "figures")
 FOLDERS = (*PACKAGES, "tests", "bench", "scripts", "docs")
 DOCS = sorted(p for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]
               if p.name != "decisions.md")
