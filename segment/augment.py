@@ -25,7 +25,8 @@ class AugmentConfig:
     """Ranges of the random changes; each is drawn per frame.
 
     ``crop_px``: side of the square training crop. ``scale``: (min, max) zoom factor,
-    drawn log-uniformly (0.5: the building looks half as large). ``building_centre_p``:
+    drawn log-uniformly (0.5: the building looks half as large; zooming out shows the
+    crop the wide sky and ground of a large image). ``building_centre_p``:
     probability that the crop is centred on a building pixel rather than anywhere.
     ``brightness``, ``contrast``, ``saturation``, ``channel_gain``, ``gamma``: (min, max)
     factors. ``blur_p`` / ``blur_sigma_px``, ``noise_p`` / ``noise_sigma``, ``jpeg_p`` /
@@ -34,8 +35,8 @@ class AugmentConfig:
     """
 
     crop_px: int = 128
-    scale: tuple[float, float] = (0.5, 2.0)
-    building_centre_p: float = 0.8
+    scale: tuple[float, float] = (0.25, 2.0)
+    building_centre_p: float = 0.5
     flip_p: float = 0.5
     brightness: tuple[float, float] = (0.6, 1.4)
     contrast: tuple[float, float] = (0.7, 1.3)
