@@ -47,19 +47,20 @@ def field_type(config_type: type, key: str) -> Any:
         If ``config_type`` is not a dataclass or has no such field (the message lists
         the fields it has).
     """
-    owner, hint = config_type, None
-    for part in key.split("."):
+    owner: Any = config_type
+    parts = key.split(".")
+    for k, part in enumerate(parts):
         if not dataclasses.is_dataclass(owner):
-            where = owner.__name__ if hint is None else f"{key!r} ({_type_text(hint)})"
+            where = (owner.__name__ if k == 0 else
+                     f"{'.'.join(parts[:k])!r} ({_type_text(owner)})")
             raise ValueError(f"{where} is not a dataclass: it has no field {part!r}")
         hints = typing.get_type_hints(owner)
         names = [f.name for f in dataclasses.fields(owner) if f.init]
         if part not in names:
             raise ValueError(f"{owner.__name__} has no field {part!r}; its fields: "
                              f"{', '.join(names)}")
-        hint = hints[part]
-        owner = hint
-    return hint
+        owner = hints[part]
+    return owner
 
 
 def default_value(config_type: type, key: str) -> Any:
