@@ -104,9 +104,10 @@ def parse_compare_args(argv: Sequence[str] | None,
 def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> CompareRequest:
     """What ``args`` asks to compare. Without ``--data``, the built-in default's folder
     (not generated here); ``--results`` and ``--out`` default to ``<data>-results`` and
-    ``<data>-compare``. The methods' configs take their short-run values in the built-in
-    default run and the robustness study, and are checked for running here unless
-    nothing runs in this process (``--no-run``, ``--explain``, a Ray executor).
+    ``<data>-compare``; with ``--explain SCENE METHOD`` the one method is METHOD. The
+    methods' configs take their short-run values in the built-in default run and the
+    robustness study, and are checked for running here unless nothing runs in this
+    process (``--no-run``, ``--explain``, a Ray executor: its GPUs are on its nodes).
 
     Raises
     ------
@@ -115,7 +116,7 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
     """
     default = DefaultBenchmark() if args.data is None else None
     data = (default.folder if default is not None else args.data).resolve()
-    names = _listed(args.methods)
+    names = (args.explain[1],) if args.explain else _listed(args.methods)
     runs_here = args.executor == "local" and not (args.no_run or args.explain)
     configs = method_configs(args, methods, names, runs_here=runs_here,
                              short_run=default is not None or args.robustness)

@@ -31,8 +31,9 @@ def add_method_options(parser: argparse.ArgumentParser, methods: Mapping[str, Me
                        warn: Callable[[str], None] | None = None) -> None:
     """Add ``--set`` and, in one group per method, the flags each of ``methods`` declares.
 
-    A flag that another option already uses is skipped with a line to ``warn``
-    (stderr by default): a plugin cannot break the command.
+    A flag that another option already uses, or whose help cannot be made (its config
+    type fails to build), is skipped with a line to ``warn`` (stderr by default): a
+    plugin cannot break the command.
     """
     warn = warn or (lambda line: print(line, file=sys.stderr))
     parser.add_argument(
@@ -54,6 +55,9 @@ def add_method_options(parser: argparse.ArgumentParser, methods: Mapping[str, Me
                                    help=_escaped(_help(method, option)))
             except argparse.ArgumentError as exc:
                 warn(f"option {option.flag} of method {method.name} skipped: {exc}")
+            except Exception as exc:  # a broken plugin must not stop the command
+                warn(f"option {option.flag} of method {method.name} skipped: "
+                     f"{type(exc).__name__}: {exc}")
 
 
 def method_configs(args: argparse.Namespace, methods: Mapping[str, Method],

@@ -163,3 +163,18 @@ def test_modes_exclude_each_other(capsys):
         main(["--robustness", "--degrade", "pose:0.3"])
     assert stopped.value.code == 2
     assert "not allowed with argument" in capsys.readouterr().err
+
+
+def test_explain_uses_the_explained_methods_options(methods, tmp_path, capsys):
+    data, results = make_benchmark(tmp_path)
+    base = ["--data", str(data), "--results", str(results), "--methods", "2D-S"]
+    argv = [*base, "--explain", "sky_a", "neural3d", "--neural3d-steps", "300"]
+    request = compare_request(parse_compare_args(argv, methods), methods)
+    assert request.methods == ("neural3d",)
+    assert request.configs == {"neural3d": Neural3dBudget(steps=300)}
+    assert (request.results, request.out) == (results, data.with_name("data-compare"))
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert text.startswith(f"# sky_a / neural3d / train: {results}/sky_a__neural3d__train.json")
+    assert main([*base, "--explain", "nowhere", "2D-S"]) == 2
+    assert "error: no scene 'nowhere' in" in capsys.readouterr().err
