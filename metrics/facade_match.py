@@ -1,6 +1,6 @@
 """Match a method's own facades to the truth's facades, so per-facade errors can be taken.
 
-Methods that find facades without ground truth (neural3d groups its mesh by
+Methods that find facades without ground truth (grouping a mesh by
 normal direction) number them 1..K in their own order. Evaluation pairs them
 with the truth by where they are, from each estimate's ``normal`` and
 ``centre_m`` (world frame, :class:`dataset.core.results.FacadeEstimate`) and the

@@ -256,7 +256,7 @@ def _footprints(scene: str, scene_dir: Path, out_dir: Path) -> str:
 
 
 def _mesh_viewer(scene: str, out_dir: Path) -> str:
-    """The semantic meshes of ``scene`` (decimated; ``<method>_runs.json``, neural3d's), drawn
+    """The semantic meshes of ``scene`` (decimated; each ``<method>_runs.json``), drawn
     when the building is opened."""
     return "".join(_one_mesh(run, i) for i, run in enumerate(
         r for r in read_mesh_pointers(out_dir) if r.scene == scene))
@@ -300,7 +300,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m metrics.html_report",
         description="(Re)make report.html, one self-contained offline page with the tables, "
-        "interactive charts, per-building details and the neural3d mesh viewer, from the output "
+        "interactive charts, per-building details and the mesh viewer, from the output "
         "folder of `python -m metrics.compare`.")
     parser.add_argument("--out", type=Path, required=True,
                         help="the comparison's output folder (its --out); report.html goes there")
