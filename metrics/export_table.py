@@ -175,8 +175,10 @@ def estimates_by_truth_facade(result: MethodResult, truth: BuildingTruth
 
     Results on ideal / multi views carry the truth's ids; results that locate
     their own facades are matched (:func:`metrics.facade_match.match_facades`).
-    ``None`` when neither applies or the match fails.
+    ``None`` when the result has no per-facade figures, neither applies or the match fails.
     """
+    if not result.facades:
+        return None
     if result.facade_identity == "truth_id":
         by_id = {e.id: e for e in result.facades}
         return tuple(by_id.get(f.id, FacadeEstimate(id=f.id, wwr=None, missing=True,
