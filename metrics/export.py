@@ -185,7 +185,11 @@ def _write_cityjson(inputs: ExportInputs, norths: dict[str, North], folder: Path
                 if method != TRUTH_METHOD and estimates is None:
                     continue  # a result whose facades cannot be put on the truth's
                 name = "__".join(filter(None, (truth.id, method, protocol))) + ".city.json"
-                doc = cityjson_building(truth, north, method, protocol, estimates, stamp)
+                try:
+                    doc = cityjson_building(truth, north, method, protocol, estimates, stamp)
+                except ValueError as exc:  # one building's odd wall skips its file, not all
+                    print(f"CityJSON {name} skipped: {exc}", file=sys.stderr)
+                    continue
                 (tmp / name).write_text(json.dumps(doc, separators=(",", ":")) + "\n")
                 names.append(name)
     return [folder / n for n in names]

@@ -135,7 +135,8 @@ def _window_ring(corners: np.ndarray, wwr: float | None) -> np.ndarray | None:
     ring2d = np.stack([cx + scale * (ring2d[:, 0] - cx), cy + scale * (ring2d[:, 1] - cy)],
                       axis=1)
     if not plan.contains(Polygon(ring2d)):
-        raise ValueError("a window scaled about the wall's centroid leaves the wall")
+        raise ValueError("a window scaled about a wall's centroid would leave the (non-convex) "
+                         "wall")
     return origin + ring2d[:, :1] * u + ring2d[:, 1:] * v  # the wall's own winding
 
 

@@ -56,11 +56,11 @@ def header_lines(produced_by: str, norths: Mapping[str, North]) -> tuple[str, ..
         f"north of {b}: {n.deg:g} deg ({n.source})" for b, n in sorted(norths.items())))
 
 
-def metadata(produced_by: str, norths: Mapping[str, North], **extra: Any) -> dict[str, Any]:
+def metadata(produced_by: str, norths: Mapping[str, North]) -> dict[str, Any]:
     """The ``metadata`` object of a JSON export (the same content as :func:`header_lines`)."""
     return {"produced_by": produced_by, "conventions": list(CONVENTIONS),
             "north": {b: {"north_deg": n.deg, "north_source": n.source}
-                      for b, n in sorted(norths.items())}, **extra}
+                      for b, n in sorted(norths.items())}}
 
 
 def facades_csv(rows: Sequence[FacadeRow], header: Sequence[str]) -> str:

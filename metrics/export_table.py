@@ -118,13 +118,9 @@ def oriented_estimates(result: MethodResult, truth: BuildingTruth | None, north:
                    if truth is not None and result.facade_identity == "truth_id" else {})
     out: list[tuple[FacadeEstimate, AzimuthFrom]] = []
     for est in result.facades:
-        if est.normal is not None:
-            azimuth, source = azimuth_deg_from_normal(est.normal, north.deg), "estimate normal"
-        elif est.id in true_normal:
-            azimuth, source = azimuth_deg_from_normal(true_normal[est.id], north.deg), \
-                "truth facade"
-        else:
-            azimuth, source = None, ""
+        normal, source = ((est.normal, "estimate normal") if est.normal is not None else
+                          (true_normal.get(est.id), "truth facade"))
+        azimuth = None if normal is None else azimuth_deg_from_normal(normal, north.deg)
         out.append((replace(est, azimuth_deg=azimuth), source if azimuth is not None else ""))
     return tuple(out)
 
