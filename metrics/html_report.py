@@ -21,6 +21,7 @@ from dataset.core.protocols import IDEAL_PROTOCOL
 from dataset.core.semantic_ply import read_semantic_ply
 from metrics.aggregate import Summary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
+from metrics.html_orientation import orientation_section
 from metrics.html_sections import (
     PAGE_CSS,
     PAGE_JS,
@@ -82,7 +83,8 @@ def build_report(out_dir: Path) -> str:
         f"<h1>envelope-bench comparison</h1><p>{esc(provenance.get('produced_by', ''))}</p>"
         f'<div id="overview"><h2>Table 2: errors per family</h2>{table2_html(table2)}'
         f"<h2>Table 3: footprint IoU</h2>{table3_html(table3)}"
-        f"<h2>Charts</h2>{errors_chart(table2)}{iou_chart(rows)}</div>"
+        f"<h2>Charts</h2>{errors_chart(table2)}{iou_chart(rows)}"
+        f"{orientation_section(out_dir)}</div>"
         f'<h2>Buildings</h2><p>Click a building to see its details.</p>'
         f'<nav class="buildings">{nav}</nav>{buildings}{provenance_footer(provenance)}'
     )
