@@ -54,8 +54,7 @@ def cityjson_building(truth: BuildingTruth, north: North, method: str, protocol:
     ValueError
         If the truth has no facade outlines (imported meshes): there are no walls to draw.
     """
-    from cjio.cityjson import CityJSON
-
+    CityJSON = _cjio_cityjson_class()
     if not truth.facade_outlines_m:
         raise ValueError(f"{truth.id} has no facade outlines in building.json (an imported "
                          "mesh): no walls to draw in CityJSON")
@@ -95,6 +94,25 @@ def cityjson_building(truth: BuildingTruth, north: North, method: str, protocol:
     model.compress(important_digits=IMPORTANT_DIGITS)  # adds "transform", merges duplicates
     model.update_bbox()
     return model.j
+
+
+def _cjio_cityjson_class() -> type:
+    """``cjio.cityjson.CityJSON``, imported without its side effect on :mod:`json`.
+
+    Importing cjio replaces ``json.encoder``'s float encoder and C encoder for the whole
+    process (floats written with 6 digits from then on), which would round every JSON this
+    process writes afterwards (result files, ``transforms.json``); both are put back.
+    """
+    import json.encoder
+
+    saved = dict(vars(json.encoder))
+    try:
+        from cjio.cityjson import CityJSON
+    finally:
+        for name in set(vars(json.encoder)) - set(saved):
+            delattr(json.encoder, name)  # cjio's `float` shadowing the builtin
+        vars(json.encoder).update(saved)
+    return CityJSON
 
 
 def _figures(facade: FacadeTruth, estimate: FacadeEstimate | None, is_truth: bool,

@@ -262,3 +262,10 @@ def test_cli_reads_folders_and_north_override(tmp_path, capsys):
     assert "unknown format" in capsys.readouterr().err
     assert main(["--results", str(tmp_path / "none")]) == 2
     assert "run `python -m metrics.compare` first" in capsys.readouterr().err
+
+
+def test_writing_cityjson_leaves_json_floats_whole(exported):
+    """cjio patches :mod:`json` when imported; the export puts it back, so files written
+    afterwards in the same process (results, transforms.json) keep every digit."""
+    assert json.dumps(0.1 + 0.2) == "0.30000000000000004"
+    assert json.dumps({"x": 1 / 3}) == '{"x": 0.3333333333333333}'
