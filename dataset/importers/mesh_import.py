@@ -169,17 +169,17 @@ def building_from_mesh(
     footprint = cross_section_footprint(raycaster, grade_z + config.footprint_height_m)
     window, wall, door = (sum(getattr(f, k) for f in facades)
                           for k in ("window_area_m2", "wall_area_m2", "door_area_m2"))
-    areas = ClassAreas(window, wall, door)
+    totals = ClassAreas(window, wall, door)
     truth = BuildingTruth(
         id=building_id,
         type="imported",
         floors=max(1, round(height_m / config.floor_height_m)),
         height_m=height_m,
         window_area_m2=window,
-        facade_area_m2=areas.gross_m2,
+        facade_area_m2=totals.gross_m2,
         wall_area_m2=wall,
         door_area_m2=door,
-        wwr=areas.wwr,
+        wwr=totals.wwr,
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,

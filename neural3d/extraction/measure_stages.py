@@ -223,7 +223,7 @@ def fill_concave_corners(state: MeasureState, config: MeasureConfig) -> MeasureS
     Assumes sharp corners: walls 45-135 degrees apart meet in a vertical line, and a
     fillet or chamfer there is the field's doing. Biases high on a building whose
     inner corner really is chamfered or rounded (a chamfer with 1.2 m legs on a
-    6 m high L: 240 m² counted where 235.7 m² are built, issue 32).
+    6 m high L: 240 m² counted where 235.8 m² are built, issue 32).
     """
     probes = _needs(state.probes, "plane_probe")
     corners = concave_corner_fill(_rays(state), state.planes, list(probes),
