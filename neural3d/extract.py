@@ -35,7 +35,13 @@ from dataset.core.protocols import TRAIN_PROTOCOL
 from dataset.core.resources import check_mesh_resources
 from dataset.core.results import FacadeEstimate, MethodResult, code_version, write_result
 from dataset.core.semantic_ply import write_semantic_ply
-from neural3d.extraction.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
+from neural3d.extraction.extract_config import (
+    STAGES,
+    ExtractConfig,
+    footprint_cell_m,
+    footprint_heights_m,
+    without_stages,
+)
 from neural3d.extraction.footprint import footprint_from_sdf
 from neural3d.extraction.measure import MeshMeasurement, measure_semantic_mesh
 from neural3d.extraction.meshing import (
@@ -270,11 +276,15 @@ def main(argv: list[str] | None = None) -> int:
                         help="measure the field as it was at this evaluation step (its "
                              "snapshot in RUN/snapshots/) instead of the final one; output "
                              "to RUN/extract/step_<STEP> unless --out")
+    parser.add_argument("--without", default="", metavar="STAGE[,STAGE]",
+                        help="measure with these stages off (and the stages that need them; "
+                             f"docs/neural3d-extract.md): {', '.join(STAGES)}")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
 
     def body() -> int:
-        config = ExtractConfig(resolution=args.resolution)
+        off = [s.strip() for s in args.without.split(",") if s.strip()]
+        config = without_stages(ExtractConfig(resolution=args.resolution), *off)
         check_mesh_resources(config.resolution)
         if args.out is not None:
             check_output_folder(args.out)

@@ -138,6 +138,8 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert "does not exist" in err and "\n" not in err
     assert main(["--run", str(tmp_path)]) == 2  # a folder that is no run
     assert "config.json is missing" in capsys.readouterr().err
+    assert main(["--run", str(tmp_path), "--without", "corners"]) == 2
+    assert "unknown stage(s) ['corners']" in capsys.readouterr().err
     assert not (tmp_path / "extract").exists()
 
 
@@ -157,9 +159,13 @@ def test_extract_run_on_a_trained_run(box_building, tmp_path):
     config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
     run_dir = train(scene, config, tmp_path / "runs", device=torch.device("cpu"))
     out = tmp_path / "out"
-    assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out)]) == 0
+    assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out),
+                 "--without", "occluded_fill,roofed_hole_fill"]) == 0
     result = read_result(out / result_filename("box", "neural3d", "train"))
     assert (result.method, result.protocol) == ("neural3d", "train")
+    stages = result.config["measure"]["stages"]
+    assert not stages["occluded_fill"] and stages["concave_corner_fill"]
+    assert not result.config["roofed_hole_fill"]
     assert [f.id for f in result.facades] == list(range(1, len(result.facades) + 1))
     assert all(f.normal is not None and f.centre_m is not None for f in result.facades)
     v, f, labels, rgb = read_semantic_ply(out / "mesh.ply")
