@@ -186,7 +186,14 @@ def main(argv: list[str] | None = None) -> int:
                   and (args.scenes is None or p.name in args.scenes)) if runs_dir.is_dir() else []
     if not runs:
         parser.error(f"no trained runs in {runs_dir}")
-    saved = json.loads(args.compare_to.read_text()) if args.compare_to else None
+    saved = None
+    if args.compare_to is not None:
+        try:
+            saved = json.loads(args.compare_to.read_text())
+            saved["buildings"]
+        except (OSError, ValueError, TypeError, KeyError) as exc:
+            parser.error(f"--compare-to {args.compare_to}: not a file this bench wrote with "
+                         f"--json ({exc})")
     torch.set_num_threads(args.threads)
     extract = ExtractConfig(resolution=args.resolution)
     buildings = [measure_building(run, extract, sets) for run in runs]
