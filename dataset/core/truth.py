@@ -3,7 +3,7 @@
 Areas follow one convention everywhere: a window's (or door's) area is its
 opening in the facade plane; the reveal (the shallow recess around it) is not
 facade area. Gross facade area = wall + window + door; WWR comes from
-:func:`dataset.core.wwr.wwr_from_areas`, the project's one definition.
+:class:`dataset.core.wwr.ClassAreas`, the project's one definition.
 """
 
 from __future__ import annotations
