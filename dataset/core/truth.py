@@ -26,7 +26,10 @@ class FacadeTruth:
 
     ``normal`` is the outward unit vector in the world frame (for a curved
     facade, the mean outward direction); ``width_m`` is measured along the wall
-    (arc length for a curved one).
+    (arc length for a curved one). ``visible_*_area_m2``: the part seen straight on
+    from the front, not hidden by a railing, a balcony or an overhang
+    (:mod:`dataset.families.visible_facade`); ``None`` where not computed (older files,
+    imported meshes).
     """
 
     id: int
@@ -39,6 +42,9 @@ class FacadeTruth:
     facade_area_m2: float
     wwr: float
     curved: bool = False
+    visible_window_area_m2: float | None = None
+    visible_wall_area_m2: float | None = None
+    visible_door_area_m2: float | None = None
 
 
 @dataclass(frozen=True)
@@ -82,6 +88,15 @@ class BuildingTruth:
                             for outline in walls)
             for fid, walls in outlines.items()
         })
+
+    def visible_areas_m2(self) -> tuple[float, float, float] | None:
+        """(window, wall, door) areas seen straight on, summed over facades, m²; ``None``
+        unless every facade has them."""
+        parts = [(f.visible_window_area_m2, f.visible_wall_area_m2, f.visible_door_area_m2)
+                 for f in self.facades]
+        if not parts or any(x is None for p in parts for x in p):
+            return None
+        return tuple(float(sum(p[k] for p in parts)) for k in range(3))  # type: ignore[return-value]
 
     def facade(self, facade_id: int) -> FacadeTruth:
         """The facade with id ``facade_id``."""
