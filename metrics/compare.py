@@ -29,9 +29,9 @@ from dataset.core.results import code_version
 from dataset.core.truth import BuildingTruth, read_building
 from dataset.degrade.spec import parse_specs
 from dataset.executors.ray_tasks import RayConfig
-from metrics.aggregate import aggregate_by_family
+from metrics.aggregate import GroupSummary, aggregate_by_family
 from metrics.benchmark_cache import DefaultBenchmark, ensure_benchmark
-from metrics.compare_args import neural3d_config, parse_compare_args, study_config
+from metrics.compare_args import neural3d_config, parse_compare_args, parse_seeds, study_config
 from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import (
     NO_TRUTH_FAMILY,
@@ -54,6 +54,9 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
+from metrics.report_paper import paper_table2_comparison, paper_table3_comparison
+from metrics.report_seeds import seed_spread_table
+from metrics.report_visible import table2_visible_errors
 from metrics.robustness import RobustnessStudy, robustness_table, run_study
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -73,6 +76,7 @@ class Comparison:
     table2: Table
     table3: Table
     outcomes: tuple[Outcome, ...]
+    more_tables: tuple[Table, ...] = ()  # against the visible truth, seed spread, the paper's
 
 
 def compare(
@@ -114,11 +118,12 @@ def compare(
         table2=replace(table2, notes=(*table2.notes, footer)),
         table3=replace(table3, notes=(*table3.notes, footer)),
         outcomes=tuple(outcomes),
+        more_tables=claims_tables(groups),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
     comment = f"produced by `{command}`; {footer}"
     out_dir.mkdir(parents=True, exist_ok=True)
-    for table in (comparison.table2, comparison.table3):
+    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
         write_table(table, out_dir, comment)
     for table in (per_building_table(rows), per_facade_table(facade_rows),
                   timing_table(run_timings(outcomes))):
@@ -133,6 +138,14 @@ def compare(
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
     _write_html_report(out_dir)
     return comparison
+
+
+def claims_tables(groups: Sequence[GroupSummary]) -> tuple[Table, ...]:
+    """Table 2 against the full and the visible facade truth, the seed-to-seed spread (when
+    a method ran with several seeds) and ours beside the BuildNet3D paper's Tables 2 and 3."""
+    seeds = seed_spread_table(groups)
+    return (table2_visible_errors(groups), *([seeds] if seeds is not None else []),
+            paper_table2_comparison(groups), paper_table3_comparison(groups))
 
 
 def evaluate(
@@ -294,7 +307,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             degradation = parse_specs(args.degrade, seed=args.degrade_seed)
             run = degraded_run(data, results, out, degradation)
             data, results, out = run.data, run.results, run.out
-        specs = method_specs(methods, views, results, configs=configs)
+        specs = method_specs(methods, views, results, configs=configs,
+                             seeds=parse_seeds(args.seeds))
         if args.degrade:
             specs = with_degradation(specs, degradation)
         argv_text = " ".join(sys.argv[1:] if argv is None else argv)
@@ -303,8 +317,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                              command=f"python -m metrics.compare {argv_text}".strip(),
                              execute=execute)
         print()
-        print(to_text(comparison.table2))
-        print(to_text(comparison.table3))
+        for table in (comparison.table2, comparison.table3, *comparison.more_tables):
+            print(to_text(table))
         print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
               f"(results in {results}); {time.perf_counter() - start:.0f} s")
         return 0

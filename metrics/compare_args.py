@@ -59,6 +59,12 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
                         help="marching-cubes samples along the scene box's longest side "
                         "(default: neural3d's own; the built-in default run uses "
                         f"{DefaultBenchmark.neural3d_resolution})")
+    parser.add_argument("--seeds", default="0",
+                        help="comma-separated training seeds of the methods that train "
+                        "(neural3d): one result per seed and building (seed k > 0 in "
+                        "<scene>__neural3d__train__seed<k>.json); the tables average a "
+                        "building's seeds, then bootstrap over buildings, and report the "
+                        "seed-to-seed spread (default: 0)")
     parser.add_argument("--device", default="cpu",
                         help="torch device for neural3d: cpu or cuda (default: cpu)")
     parser.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
@@ -91,6 +97,23 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
                            "building, method and views")
     add_debug_flag(parser)
     return parser.parse_args(argv)
+
+
+def parse_seeds(text: str) -> tuple[int, ...]:
+    """``--seeds``: distinct non-negative integers, in the order given.
+
+    Raises
+    ------
+    ValueError
+        If an entry is not a non-negative integer or repeats.
+    """
+    try:
+        seeds = tuple(int(s) for s in text.split(",") if s.strip())
+    except ValueError:
+        raise ValueError(f"--seeds must be comma-separated integers, got {text!r}") from None
+    if not seeds or min(seeds) < 0 or len(set(seeds)) != len(seeds):
+        raise ValueError(f"--seeds needs distinct non-negative integers, got {text!r}")
+    return seeds
 
 
 def neural3d_config(args: argparse.Namespace, default: DefaultBenchmark | None) -> Neural3dBudget:
