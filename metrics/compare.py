@@ -54,9 +54,14 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
-from metrics.report_paper import paper_table2_comparison, paper_table3_comparison
-from metrics.report_seeds import seed_spread_table
-from metrics.report_visible import table2_visible_errors
+from metrics.report_paper import (
+    PAPER_TABLE2_NAME,
+    PAPER_TABLE3_NAME,
+    paper_table2_comparison,
+    paper_table3_comparison,
+)
+from metrics.report_seeds import SEED_TABLE_NAME, seed_spread_table
+from metrics.report_visible import TABLE2_VISIBLE_NAME, table2_visible_errors
 from metrics.robustness import RobustnessStudy, robustness_table, run_study
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -65,6 +70,7 @@ PROVENANCE_FILE = "provenance.json"
 PIPELINE_FOLDER = "2dss_pipeline"
 FOOTPRINTS_FOLDER = "footprints"
 PLOTS_FOLDER = "plots"
+CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME)
 
 
 @dataclass(frozen=True)
@@ -125,6 +131,9 @@ def compare(
     out_dir.mkdir(parents=True, exist_ok=True)
     for table in (comparison.table2, comparison.table3, *comparison.more_tables):
         write_table(table, out_dir, comment)
+    for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
+        for suffix in (".csv", ".md", ".tex"):  # a table with no rows this time: none stale
+            (out_dir / f"{name}{suffix}").unlink(missing_ok=True)
     for table in (per_building_table(rows), per_facade_table(facade_rows),
                   timing_table(run_timings(outcomes))):
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
@@ -142,10 +151,11 @@ def compare(
 
 def claims_tables(groups: Sequence[GroupSummary]) -> tuple[Table, ...]:
     """Table 2 against the full and the visible facade truth, the seed-to-seed spread (when
-    a method ran with several seeds) and ours beside the BuildNet3D paper's Tables 2 and 3."""
-    seeds = seed_spread_table(groups)
-    return (table2_visible_errors(groups), *([seeds] if seeds is not None else []),
-            paper_table2_comparison(groups), paper_table3_comparison(groups))
+    a method ran with several seeds) and ours beside the BuildNet3D paper's Tables 2 and 3
+    (each only when it has a row)."""
+    tables = (table2_visible_errors(groups), seed_spread_table(groups),
+              paper_table2_comparison(groups), paper_table3_comparison(groups))
+    return tuple(t for t in tables if t is not None and t.rows)
 
 
 def evaluate(

@@ -27,8 +27,8 @@ PAPER_BUILDINGS = 4  # per type, in Tables 2 and 3
 PAPER_METHODS = {"2D-S": "2D-S", "2D-SS": "2D-SS", "neural3d": "BuildNet3D"}
 CAVEATS = (
     "the buildings differ: the paper's four per type are its own renders, ours are this "
-    "project's presets (paper: 12 + 12 + 4; heldout: 6 + 6 + 8), so equal figures mean "
-    "equal accuracy on different buildings",
+    "project's (the Buildings column), so equal figures mean equal accuracy on different "
+    "buildings",
     "the paper trains BuildNet3D for 100,000 MLP iterations (batch 2048 rays, one A100); "
     "neural3d's figures here are at the step budget in the Steps column",
     "both use exact semantic masks rendered with the buildings (no segmentation network)",

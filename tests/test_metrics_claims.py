@@ -121,3 +121,12 @@ def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
     again = run_missing(scenes, specs, tmp_path / "results", log=lambda _: None)
     assert [o.status for o in again] == ["reused", "reused"] and calls == [0, 1]
     assert again[1].result.wwr == pytest.approx(0.26)
+
+
+def test_claims_tables_leave_out_tables_without_rows():
+    from metrics.compare import claims_tables
+
+    rows = [BuildingErrors(s, "l_shaped", "2D-S", "ideal", wwr_ape=e) for s, e in (("a", 1.0),
+                                                                                  ("b", 2.0))]
+    names = [t.name for t in claims_tables(aggregate_by_family(rows))]
+    assert names == ["table2_visible", "paper_table2"]  # no seeds, no footprint in the paper
