@@ -28,6 +28,7 @@ IN_FRONT_TOL_M = 1e-6
 """A point this far or less in front of a facade plane lies on it (the mesh merges vertices
 at 1 nm, and surfaces that touch a facade at an edge, like reveals, must not hide it)."""
 PLANE_DECIMALS = 6  # facade triangles whose normal and offset agree to 1 µm share a plane
+MIN_SHADOW_M2 = 1e-12  # a triangle seen edge-on from the plane projects to (almost) nothing
 
 
 def hidden_facade_areas_m2(mesh: LabelledMesh) -> dict[int, dict[int, float]]:
@@ -69,21 +70,23 @@ def _hidden_in_plane(triangles: np.ndarray, members: np.ndarray, labels: np.ndar
     others = np.ones(len(triangles), dtype=bool)
     others[members] = False
     flat = triangles @ basis.T  # (F, 3, 2)
-    candidates = others & (depth.max(axis=1) > IN_FRONT_TOL_M)
+    edges = flat[:, 1:] - flat[:, :1]
+    flat_area = 0.5 * np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
+    # Faces edge-on to the plane (reveals, the sides of a slab) cast no shadow.
+    candidates = others & (depth.max(axis=1) > IN_FRONT_TOL_M) & (flat_area > MIN_SHADOW_M2)
     candidates &= np.all(flat.max(axis=1) > lo, axis=1) & np.all(flat.min(axis=1) < hi, axis=1)
-    shadows = []
-    for i in np.flatnonzero(candidates):
+    whole = candidates & (depth.min(axis=1) > IN_FRONT_TOL_M)
+    shadows = list(shapely.polygons(flat[whole]))
+    for i in np.flatnonzero(candidates & ~whole):
         ring = _clip_in_front(triangles[i], depth[i])
         if len(ring) >= 3:
-            poly = Polygon(ring @ basis.T)
-            if poly.area > 0:
-                shadows.append(poly)
+            shadows.append(Polygon(ring @ basis.T))
     if not shadows:
         return {}
     shadow = shapely.union_all(shadows)
     out: dict[int, float] = {}
     for label in np.unique(labels):
-        faces = shapely.union_all([Polygon(t) for t in own[labels == label]])
+        faces = shapely.union_all(shapely.polygons(own[labels == label]))
         out[int(label)] = float(faces.intersection(shadow).area)
     return out
 
