@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from dataset.families.building_assembly import BuildingLayout
-from dataset.families.facade_geometry import Opening, window_grid
+from dataset.families.facade_geometry import Opening, WallSpec, window_grid
 from dataset.families.heldout_openings import (
     DOOR_HEIGHT_M,
     DOOR_THRESHOLD_M,
@@ -52,14 +52,21 @@ def corner_footprint(width_m: float, depth_m: float, corner_deg: float) -> np.nd
     return np.array([[-w, -d], [w, -d], [w - shift, d], [-w, d]])
 
 
+def plan_walls(footprint_xy: np.ndarray, params: HeldoutParams,
+               wall_height_m: float) -> list[WallSpec]:
+    """Walls of ``wall_height_m`` over every edge of ``footprint_xy``, facade i + 1 over edge i,
+    each with its window grid; the door on facade 1."""
+    lengths = np.linalg.norm(np.roll(footprint_xy, -1, axis=0) - footprint_xy, axis=1)
+    openings = [wall_openings(float(length), params, door=i == 0)
+                for i, length in enumerate(lengths)]
+    return prism_walls(footprint_xy, wall_height_m, list(range(1, len(lengths) + 1)), openings)
+
+
 def corner_layout(params: HeldoutParams) -> BuildingLayout:
     """Walls over the trapezoid, an overhanging roof slab and the ground."""
     footprint = corner_footprint(params.width_m, params.depth_m, params.corner_deg)
-    lengths = np.linalg.norm(np.roll(footprint, -1, axis=0) - footprint, axis=1)
-    openings = [wall_openings(float(length), params, door=i == 0)
-                for i, length in enumerate(lengths)]
     top = params.floors * params.floor_height_m
-    walls = prism_walls(footprint, top, [1, 2, 3, 4], openings)
+    walls = plan_walls(footprint, params, top)
     roof = overhang_roof_faces(footprint, top, OVERHANG_M, SLAB_THICKNESS_M)
     return BuildingLayout(
         footprint_xy=footprint, walls=walls, other_faces=[ground_face(footprint), *roof],
@@ -143,12 +150,8 @@ def sawtooth_footprint(width_m: float, depth_m: float, step_m: float) -> np.ndar
 def sawtooth_layout(params: HeldoutParams) -> BuildingLayout:
     """Walls over the stepped plan (one facade per edge), parapet roof and ground."""
     footprint = sawtooth_footprint(params.width_m, params.depth_m, params.step_m)
-    lengths = np.linalg.norm(np.roll(footprint, -1, axis=0) - footprint, axis=1)
-    openings = [wall_openings(float(length), params, door=i == 0)
-                for i, length in enumerate(lengths)]
     top = params.floors * params.floor_height_m
-    walls = prism_walls(footprint, top + params.roof_m, list(range(1, len(footprint) + 1)),
-                        openings)
+    walls = plan_walls(footprint, params, top + params.roof_m)
     roof = parapet_roof_faces(footprint, top, params.roof_m, PARAPET_THICKNESS_M)
     return BuildingLayout(
         footprint_xy=footprint, walls=walls, other_faces=[ground_face(footprint), *roof],
