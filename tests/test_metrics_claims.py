@@ -130,3 +130,22 @@ def test_claims_tables_leave_out_tables_without_rows():
                                                                                   ("b", 2.0))]
     names = [t.name for t in claims_tables(aggregate_by_family(rows))]
     assert names == ["table2_visible", "paper_table2"]  # no seeds, no footprint in the paper
+
+
+def test_report_sections_show_the_visible_table_with_its_intervals(tmp_path):
+    from metrics.html_claims import claims_sections
+    from metrics.html_report import table2_html, table3_html
+
+    rows = [BuildingErrors(s, "realistic", "neural3d", "train", wwr_ape=e, footprint_iou=0.97,
+                           wwr_ape_visible=e / 2) for s, e in (("a", 2.0), ("b", 4.0))]
+    groups = aggregate_by_family(rows)
+    (tmp_path / "table2_visible.csv").write_text(to_csv(table2_visible_errors(groups)))
+    html = claims_sections(tmp_path)
+    assert "visible facade" in html and "1.50 ± 0.50 [1.00, 2.00]" in html
+    assert "seed" not in html.lower()  # no seed table written
+    from metrics.report import table2_errors, table3_footprint_iou
+
+    t2 = table2_html(read_csv_rows(to_csv(table2_errors(groups))))
+    assert "3.00 ± 1.00 [2.00, 4.00]" in t2 and "3.50 ± 2.20" in t2  # ours, then the paper's
+    t3 = table3_html(read_csv_rows(to_csv(table3_footprint_iou(groups, {"neural3d"}))))
+    assert "BuildNet3D paper, Table 3" in t3 and "0.971" in t3
