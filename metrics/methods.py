@@ -12,6 +12,7 @@ the import error as the reason, and the other methods go on.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import fields, is_dataclass, replace
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -32,9 +33,11 @@ def method_specs(
     results_dir: Path,
     *,
     configs: Mapping[str, Any] | None = None,
+    seeds: tuple[int, ...] = (0,),
 ) -> list[MethodSpec]:
     """Specs of the named methods, each run with ``configs[name]`` (default: its config
-    type's default instance); view methods run on ``views``.
+    type's default instance); view methods run on ``views``. A method whose config has a
+    ``seed`` field (neural3d: the training seed) gets one spec per seed of ``seeds``.
 
     Raises
     ------
@@ -50,8 +53,18 @@ def method_specs(
         except ImportError as exc:
             specs.append(_unavailable(name, views, exc))
             continue
-        specs.append(spec_from_method(method, views, results_dir, configs.get(name)))
+        config = configs.get(name)
+        config = method.config_type() if config is None else config
+        if _has_seed(config):
+            specs += [spec_from_method(method, views, results_dir, replace(config, seed=s))
+                      for s in seeds]
+        else:
+            specs.append(spec_from_method(method, views, results_dir, config))
     return specs
+
+
+def _has_seed(config: Any) -> bool:
+    return is_dataclass(config) and any(f.name == "seed" for f in fields(config))
 
 
 def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
@@ -60,11 +73,14 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
 
     It runs on the protocols it declares: of the view protocols, those in
     ``views``; others (``train``) always. A method with an ``artefacts`` folder
-    keeps it under ``results_dir``.
+    keeps it under ``results_dir`` (a seed other than 0 in ``seed<k>/`` below it).
     """
     config = method.config_type() if config is None else config
     protocols = tuple(p for p in method.protocols if p not in VIEW_PROTOCOLS or p in views)
+    seed = config.seed if _has_seed(config) else None
     artefacts_dir = results_dir / method.artefacts if method.artefacts else None
+    if artefacts_dir is not None and seed:
+        artefacts_dir = artefacts_dir / f"seed{seed}"
     run = partial(_run_on_folder, method, config)
     if artefacts_dir is not None:
         run = partial(run, artefacts_dir=artefacts_dir)
@@ -76,7 +92,7 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
                       resources=TaskResources(cpus=cpus, gpus=gpus),
                       artefacts_dir=artefacts_dir, code=("dataset", *method.packages),
                       libraries=method.libraries, mesh_file=method.mesh_file,
-                      heavy=method.heavy, debug_images=debug_images)
+                      heavy=method.heavy, debug_images=debug_images, seed=seed)
 
 
 def _run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
