@@ -22,7 +22,6 @@ from shapely.ops import unary_union
 from dataset.core.footprint import geojson_to_polygon
 from dataset.core.results import MethodResult
 from dataset.core.truth import BuildingTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
 from metrics.facade_match import has_facade_geometry, match_facades
 
 Status = Literal["ok", "failed"]
@@ -215,14 +214,12 @@ def visible_errors(result: MethodResult, truth: BuildingTruth | None) -> dict[st
     visible = truth.visible_areas_m2() if truth is not None else None
     if visible is None:
         return {"wwr_ape_visible": None, "window_ape_visible": None, "facade_ape_visible": None}
-    window, wall, door = visible
     notes: list[str] = []  # a truth without visible windows has no percentage error: None
     return {
-        "wwr_ape_visible": _ape_or_none(result.wwr, wwr_from_areas(window, wall, door), notes,
-                                        "WWR"),
-        "window_ape_visible": _ape_or_none(result.window_area_m2, window, notes, "window"),
-        "facade_ape_visible": _ape_or_none(result.facade_area_m2,
-                                           gross_facade_area_m2(wall, window, door), notes,
+        "wwr_ape_visible": _ape_or_none(result.wwr, visible.wwr, notes, "WWR"),
+        "window_ape_visible": _ape_or_none(result.window_area_m2, visible.window_m2, notes,
+                                           "window"),
+        "facade_ape_visible": _ape_or_none(result.facade_area_m2, visible.gross_m2, notes,
                                            "facade"),
     }
 

@@ -14,6 +14,7 @@ from shapely.geometry import MultiLineString, Polygon
 from shapely.ops import polygonize, unary_union
 
 from dataset.core.footprint import geojson_to_polygon
+from dataset.core.wwr import ClassAreas
 from dataset.families.heldout import make_heldout, sample_heldout_params
 from dataset.families.heldout_params import HELDOUT_MODELS, HeldoutParams, default_heldout_params
 from dataset.families.heldout_plan import STEPS, bow_footprint
@@ -56,7 +57,7 @@ def test_mansard_is_seen_whole_under_its_steep_roof():
     eave = p.floors * p.floor_height_m
     assert t.height_m == pytest.approx(eave + p.roof_m)
     assert t.facade(1).facade_area_m2 == pytest.approx(p.width_m * eave)
-    assert t.visible_areas_m2() == (t.window_area_m2, t.wall_area_m2, t.door_area_m2)
+    assert t.visible_areas_m2() == ClassAreas(t.window_area_m2, t.wall_area_m2, t.door_area_m2)
 
 
 def test_setback_tiers_are_their_own_facades():

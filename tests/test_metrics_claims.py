@@ -6,6 +6,7 @@ import pytest
 from metrics_helpers import make_result, make_truth
 
 from dataset.core.results import read_result, result_filename, write_result
+from dataset.core.wwr import ClassAreas
 from metrics.aggregate import aggregate_by_family, seed_mean, seed_sd
 from metrics.compare_args import parse_seeds
 from metrics.errors import BuildingErrors, building_errors, failed_building
@@ -53,7 +54,7 @@ def test_errors_against_the_visible_truth():
     f2 = replace(truth.facades[1], visible_window_area_m2=5.0, visible_wall_area_m2=13.0,
                  visible_door_area_m2=2.0)
     truth = replace(truth, facades=(f1, f2))
-    assert truth.visible_areas_m2() == (13.0, 39.0, 2.0)  # gross 54, WWR 13 / 54
+    assert truth.visible_areas_m2() == ClassAreas(13.0, 39.0, 2.0)  # gross 54, WWR 13 / 54
     result = make_result("a", "2D-S", "ideal", 13.0 / 54.0, window_m2=13.0, facade_m2=54.0)
     row = building_errors(result, truth)
     assert row.wwr_ape_visible == pytest.approx(0.0, abs=1e-12)

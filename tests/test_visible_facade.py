@@ -7,6 +7,7 @@ import pytest
 
 from dataset.core.classes import SemanticClass
 from dataset.core.truth import read_building, write_building
+from dataset.core.wwr import ClassAreas
 from dataset.families.facade_geometry import WallFrame, WallSpec, rectangle_outline, wall_faces
 from dataset.families.polygon_mesh import triangulate_faces
 from dataset.families.realistic import make_realistic
@@ -72,7 +73,7 @@ def test_the_roof_slab_hides_a_strip_under_the_eaves_of_the_house():
 
 def test_a_plain_block_is_seen_whole_and_the_fields_round_trip(tmp_path):
     t = make_skyscraper(SkyscraperParams()).truth
-    assert t.visible_areas_m2() == (t.window_area_m2, t.wall_area_m2, t.door_area_m2)
+    assert t.visible_areas_m2() == ClassAreas(t.window_area_m2, t.wall_area_m2, t.door_area_m2)
     write_building(tmp_path / "building.json", t)
     assert read_building(tmp_path / "building.json") == t
     old = json.loads((tmp_path / "building.json").read_text())

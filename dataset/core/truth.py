@@ -22,6 +22,7 @@ from dataset.core.orientation import (
     azimuth_deg_from_normal,
     orientation_bin,
 )
+from dataset.core.wwr import ClassAreas
 
 BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
 BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
@@ -119,14 +120,15 @@ class BuildingTruth:
             replace(f, azimuth_deg=azimuth_deg_from_normal(f.normal, self.north_deg))
             for f in self.facades))
 
-    def visible_areas_m2(self) -> tuple[float, float, float] | None:
-        """(window, wall, door) areas seen straight on, summed over facades, m²; ``None``
+    def visible_areas_m2(self) -> ClassAreas | None:
+        """Window, wall and door areas seen straight on, summed over facades; ``None``
         unless every facade has them."""
         parts = [(f.visible_window_area_m2, f.visible_wall_area_m2, f.visible_door_area_m2)
                  for f in self.facades]
         if not parts or any(x is None for p in parts for x in p):
             return None
-        return tuple(float(sum(p[k] for p in parts)) for k in range(3))  # type: ignore[return-value]
+        window, wall, door = (float(sum(p[k] for p in parts)) for k in range(3))
+        return ClassAreas(window_m2=window, wall_m2=wall, door_m2=door)
 
     def facade(self, facade_id: int) -> FacadeTruth:
         """The facade with id ``facade_id``."""
