@@ -23,9 +23,13 @@ from tqdm import tqdm
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.mesh import LabelledMesh
 from dataset.core.truth import Building
-from dataset.importers.ifc_classes import SKIP, class_of_element
+from dataset.importers.ifc_classes import SKIP, class_of_element, interior_flagged_entities
+from dataset.importers.ifc_ground import GroundLevel, ground_level
 from dataset.importers.import_config import ImportConfig
-from dataset.importers.mesh_import import building_from_mesh
+from dataset.importers.mesh_import import NoFacadeError, NoFootprintError, building_from_mesh
+
+MAX_NAMED = 5
+"""Errors and warnings name at most this many elements."""
 
 
 @dataclass(frozen=True)
@@ -51,8 +55,9 @@ class IfcModel:
     face_element : (F,) int64
         Index into ``elements`` of each face.
     elements : tuple of IfcElement
-    ground_z_m : float or None
-        The lowest storey's floor level, None without storeys.
+    ground : GroundLevel or None
+        The storey at grade (:func:`dataset.importers.ifc_ground.ground_level`), None
+        without storeys.
     warnings : dict
         Kind of problem -> how many elements had it.
     skipped : tuple of IfcElement
@@ -64,7 +69,7 @@ class IfcModel:
     mesh: LabelledMesh
     face_element: np.ndarray
     elements: tuple[IfcElement, ...]
-    ground_z_m: float | None
+    ground: GroundLevel | None
     warnings: dict[str, int]
     skipped: tuple[IfcElement, ...]
     unit_scale: float
@@ -90,7 +95,6 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
     """
     import ifcopenshell
     import ifcopenshell.geom
-    import ifcopenshell.util.placement
     import ifcopenshell.util.unit
 
     path = Path(path)
@@ -103,10 +107,13 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
     unit_scale = float(ifcopenshell.util.unit.calculate_unit_scale(model))
     warnings: Counter[str] = Counter()
     wanted: dict[int, IfcElement] = {}
+    interior = interior_flagged_entities(model)
     for product in sorted(model.by_type("IfcProduct"), key=lambda p: p.GlobalId):
-        label = class_of_element(product, overrides)
+        label = class_of_element(product, overrides, interior)
         if label == SKIP or product.Representation is None:
             continue
+        if interior and label != class_of_element(product, overrides):
+            warnings[f"{product.is_a()} with IsExternal = False: interior, classed other"] += 1
         if _has_parts(product):
             continue  # a whole whose parts carry the geometry (curtain wall, roof)
         wanted[product.id()] = IfcElement(product.GlobalId, product.is_a(),
@@ -151,10 +158,8 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
     f_all = np.concatenate(faces)
     labels = np.array([e.label for e in elements], dtype=np.uint8)[np.concatenate(face_element)]
     mesh = LabelledMesh(np.concatenate(vertices), f_all, labels, np.full(len(f_all), NO_FACADE))
-    storeys = [ifcopenshell.util.placement.get_local_placement(s.ObjectPlacement)[2, 3]
-               for s in model.by_type("IfcBuildingStorey") if s.ObjectPlacement is not None]
-    ground = float(min(storeys)) * unit_scale if storeys else None
-    return IfcModel(mesh, np.concatenate(face_element), tuple(elements), ground,
+    return IfcModel(mesh, np.concatenate(face_element), tuple(elements),
+                    ground_level(model, unit_scale),
                     dict(sorted(warnings.items())), tuple(skipped), unit_scale)
 
 
@@ -168,15 +173,16 @@ def import_ifc(
 ) -> Building:
     """Read an IFC model and derive its ground truth (as :mod:`dataset.importer` does a mesh).
 
-    The ground is ``config.ground_z_m`` when given, else the lowest storey's floor (else
-    the lowest point, with a warning). Elements that are not closed solids are kept and
-    counted in the warnings. ``truth.extra["ifc"]`` holds the element counts per class,
-    the warnings and, per IfcWindow, its declared and measured exterior areas.
+    The ground is ``config.ground_z_m`` when given, else the storey at grade
+    (:mod:`dataset.importers.ifc_ground`; else the lowest point, with a warning). Open,
+    overlapping, inside-out and single-face elements are taken as they are.
+    ``truth.extra["ifc"]`` holds the element counts per class, the ground and why, the
+    warnings and, per IfcWindow, its declared and measured exterior areas.
 
     Raises
     ------
     ValueError
-        As :func:`read_ifc` and :func:`dataset.importers.mesh_import.building_from_mesh`.
+        As :func:`read_ifc`; no facade or no footprint, naming the elements concerned.
     """
     path = Path(path)
     config = ImportConfig() if config is None else config
@@ -184,22 +190,32 @@ def import_ifc(
         raise ValueError("IFC models are z-up; leave --up-axis at z")
     model = read_ifc(path, overrides=overrides, progress=progress)
     warnings = dict(model.warnings)
+    ground = _ground_record(model.ground, config)
     if config.ground_z_m is None:
-        if model.ground_z_m is None:
+        if model.ground is None:
             warnings["no storey: ground at the lowest point"] = 1
         else:
-            config = replace(config, ground_z_m=model.ground_z_m)
-    building, parent = building_from_mesh(
-        model.mesh, building_id=building_id if building_id is not None else path.stem,
-        source=path, config=config, require_closed=False,
-    )
-    open_edges = building.truth.extra["open_edges"]
-    if open_edges["open"] or open_edges["misoriented"]:
-        warnings["edges not closed or oppositely oriented (counted once per edge)"] = (
-            open_edges["open"] + open_edges["misoriented"])
+            config = replace(config, ground_z_m=model.ground.z_m)
+            if model.ground.below:
+                warnings["storeys below the ground, not facade: " + ", ".join(
+                    f"{name} ({z:+.2f} m)" for name, z in model.ground.below)] = 1
+    if not (model.mesh.face_label == SemanticClass.ROOF).any():
+        warnings["no roof element: surfaces open to the sky count as seen from outside"] = 1
+    try:
+        building, parent = building_from_mesh(
+            model.mesh, building_id=building_id if building_id is not None else path.stem,
+            source=path, config=config, body_group=model.face_element,
+        )
+    except NoFacadeError as exc:
+        raise ValueError(f"{exc}. The wall, window and door elements above the ground: "
+                         f"{_name_elements(model, exc.facade_class_parents)}") from None
+    except NoFootprintError as exc:
+        raise ValueError(f"{exc}. Elements at that height: "
+                         f"{_name_elements(model, exc.section_parents)}") from None
     element_of_face = model.face_element[parent]
     building.truth.extra["ifc"] = {
         "elements": dict(sorted(Counter(e.label.name.lower() for e in model.elements).items())),
+        "ground": ground,
         "warnings": warnings,
         "skipped": [{"global_id": e.global_id, "type": e.ifc_type, "name": e.name}
                     for e in model.skipped],
@@ -221,6 +237,26 @@ def _window_areas(model: IfcModel, building: Building, element_of_face: np.ndarr
             for i, e in enumerate(model.elements) if e.ifc_type.startswith("IfcWindow")]
 
 
+def _ground_record(ground: GroundLevel | None, config: ImportConfig) -> dict:
+    """What ``truth.extra["ifc"]["ground"]`` says about the ground used."""
+    if config.ground_z_m is not None:
+        return {"z_m": config.ground_z_m, "storey": None, "reason": "given (--ground-z)"}
+    if ground is None:
+        return {"z_m": None, "storey": None, "reason": "no storey: the lowest point"}
+    return {"z_m": ground.z_m, "storey": ground.storey, "reason": ground.reason,
+            "below_grade_storeys": [{"name": n, "z_m": z} for n, z in ground.below]}
+
+
+def _name_elements(model: IfcModel, faces: np.ndarray) -> str:
+    """'IfcWall 2O2Fr... "Wall A"; ...' for the elements of ``faces`` (at most
+    :data:`MAX_NAMED`, then how many more)."""
+    index = np.unique(model.face_element[np.asarray(faces, dtype=np.int64)])
+    named = [f"{model.elements[i].ifc_type} {model.elements[i].global_id} "
+             f"{model.elements[i].name!r}" for i in index[:MAX_NAMED]]
+    more = f" and {len(index) - MAX_NAMED} more" if len(index) > MAX_NAMED else ""
+    return ("none" if not named else "; ".join(named)) + more
+
+
 def _declared_window_area_m2(product, unit_scale: float) -> float | None:
     if not product.is_a("IfcWindow"):
         return None
@@ -233,7 +269,7 @@ def _has_parts(product) -> bool:
                for rel in getattr(product, "IsDecomposedBy", None) or ())
 
 
-def warning_lines(ifc_record: dict, *, max_named: int = 5) -> list[str]:
+def warning_lines(ifc_record: dict, *, max_named: int = MAX_NAMED) -> list[str]:
     """One line per kind of warning with its count, then the first skipped elements by name.
 
     ``ifc_record`` is ``truth.extra["ifc"]`` of an imported building.
