@@ -119,8 +119,8 @@ def test_class_overrides_and_skipped_elements(tmp_path, houses):
     assert building.truth.facade_area_m2 == pytest.approx(2 * (10 + 8) * 3, rel=1e-9)
     lines = warning_lines(building.truth.extra["ifc"])
     assert lines[0] == "warning: 1 x skipped IfcWall: IfcOpenShell could not triangulate it"
-    assert "warning: 1 x no roof element: surfaces open to the sky count as seen from " \
-           "outside" in lines
+    assert ("warning: 1 x no roof element: a virtual flat lid at the top closes the model "
+            "for the visibility test") in lines
     assert lines[-1] == f"warning: skipped IfcWall {broken.GlobalId} 'broken'"
 
 

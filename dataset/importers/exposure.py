@@ -1,11 +1,14 @@
 """Which wall, window and door faces of an imported building are seen from outside.
 
-Stages (docs/importing.md, "Seen from outside"): every facade-class face above the ground
-is tested with rays (:func:`dataset.rendering.visibility.seen_from_outside`); a flat body
-(a single-face glass panel) is tested from both sides and turned to face the side that
-sees out; faces that other bodies' faces cover (:mod:`dataset.importers.contact`) or pass
-through (:mod:`dataset.importers.crossings`) are cut there and each piece is decided
-again, so a face is never counted whole when part of it lies inside the building.
+Stages (docs/importing.md, "Seen from outside"): a model without any roof face (an office
+exported without its roof) is closed by a virtual flat lid at its top over its footprint,
+for the rays only, so that the insides of its walls do not see the sky; every facade-class
+face above the ground is tested with rays
+(:func:`dataset.rendering.visibility.seen_from_outside`); a flat body (a single-face glass
+panel) is tested from both sides and turned to face the side that sees out; faces that
+other bodies' faces cover (:mod:`dataset.importers.contact`) or pass through
+(:mod:`dataset.importers.crossings`) are cut there and each piece is decided again, so a
+face is never counted whole when part of it lies inside the building.
 """
 
 from __future__ import annotations
@@ -14,13 +17,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.classes import FACADE_CLASSES
+from dataset.core.classes import FACADE_CLASSES, NO_FACADE, SemanticClass
 from dataset.core.mesh import LabelledMesh
 from dataset.importers.contact import split_touching_faces
 from dataset.importers.crossings import split_crossing_faces
+from dataset.importers.face_pieces import triangulate_uv
 from dataset.importers.import_config import ImportConfig
 from dataset.rendering.raycast import Raycaster
+from dataset.rendering.section import cross_section_footprint
 from dataset.rendering.visibility import escape_fractions, seen_from_outside
+
+LID_CLEARANCE_M = 0.01
+"""The virtual lid of a roofless model lies this far above its highest point."""
 
 
 @dataclass(frozen=True)
@@ -41,6 +49,9 @@ class Exposure:
         Over ``mesh``.
     turned_sheets : int
         Sheet faces turned round.
+    lid : (F',) bool
+        The virtual lid's faces (class roof; none unless the input had no roof face), to be
+        dropped from the building's mesh once its footprint is cut.
     """
 
     mesh: LabelledMesh
@@ -48,6 +59,7 @@ class Exposure:
     visible: np.ndarray
     raycaster: Raycaster
     turned_sheets: int
+    lid: np.ndarray
 
 
 def facade_candidates(mesh: LabelledMesh, grade_z_m: float) -> np.ndarray:
@@ -72,6 +84,9 @@ def exposed_faces(mesh: LabelledMesh, sheet: np.ndarray, grade_z_m: float,
     config
         Visibility options (:class:`ImportConfig`).
     """
+    n_input = len(mesh.faces)
+    mesh = _with_lid(mesh, grade_z_m, config)
+    sheet = np.concatenate([sheet, np.zeros(len(mesh.faces) - n_input, dtype=bool)])
     mesh, turned = _turn_sheets_to_the_outside(mesh, sheet, grade_z_m, config)
     parent = np.arange(len(mesh.faces))
     raycaster = Raycaster(mesh)
@@ -89,7 +104,36 @@ def exposed_faces(mesh: LabelledMesh, sheet: np.ndarray, grade_z_m: float,
     if len(cut_parent) != len(visible):
         mesh, parent, raycaster, visible = _decide_pieces(
             cut_mesh, cut_parent, parent, visible, grade_z_m, config)
-    return Exposure(mesh, parent, visible, raycaster, turned)
+    lid = parent >= n_input
+    return Exposure(mesh, np.where(lid, -1, parent), visible, raycaster, turned, lid)
+
+
+def _with_lid(mesh: LabelledMesh, grade_z_m: float, config: ImportConfig) -> LabelledMesh:
+    """The mesh and, if it has no roof face, a flat lid over its footprint's outline (holes
+    filled) :data:`LID_CLEARANCE_M` above its highest point, class roof, facing up."""
+    if (mesh.face_label == SemanticClass.ROOF).any():
+        return mesh
+    try:
+        footprint = cross_section_footprint(Raycaster(mesh),
+                                            grade_z_m + config.footprint_height_m)
+    except ValueError:
+        return mesh  # no section: the footprint step will say so
+    parts = getattr(footprint, "geoms", [footprint])
+    outline = [triangulate_uv(type(p)(p.exterior)) for p in parts]
+    uv = np.concatenate([t for t in outline if t is not None]).reshape(-1, 3, 2)
+    if len(uv) == 0:
+        return mesh
+    e1, e2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    down = (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) < 0
+    uv[down] = uv[down][:, ::-1]  # counter-clockwise seen from above: facing up
+    top = float(mesh.vertices_m[:, 2].max()) + LID_CLEARANCE_M
+    corners = np.concatenate([uv, np.full((*uv.shape[:2], 1), top)], axis=2).reshape(-1, 3)
+    faces = len(mesh.vertices_m) + np.arange(len(corners)).reshape(-1, 3)
+    n = len(faces)
+    return LabelledMesh(np.concatenate([mesh.vertices_m, corners]),
+                        np.concatenate([mesh.faces, faces]),
+                        np.concatenate([mesh.face_label, np.full(n, SemanticClass.ROOF)]),
+                        np.concatenate([mesh.face_facade, np.full(n, NO_FACADE)]))
 
 
 def _decide_pieces(mesh: LabelledMesh, cut_parent: np.ndarray, parent: np.ndarray,

@@ -30,11 +30,15 @@ from dataset.importers.mesh_import import NoFacadeError, NoFootprintError, build
 
 MAX_NAMED = 5
 """Errors and warnings name at most this many elements."""
+MAX_SKIPPED_FRACTION = 0.5
+"""An import in which IfcOpenShell cannot triangulate more than this share of the elements
+is refused (a file of broken geometry); fewer are skipped with a warning."""
 
 
 @dataclass(frozen=True)
 class IfcElement:
-    """One imported IFC product: its identity, our class and, for a window, its declared
+    """One imported IFC product: its identity, our class and, for an IfcWindow or a part of
+    one (a frame member, a glass plate), the window's GlobalId and name and its declared
     OverallWidth x OverallHeight in m² (None if not given)."""
 
     global_id: str
@@ -42,6 +46,8 @@ class IfcElement:
     name: str
     label: SemanticClass
     declared_area_m2: float | None = None
+    window_id: str | None = None
+    window_name: str = ""
 
 
 @dataclass(frozen=True)
@@ -115,10 +121,13 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
         if interior and label != class_of_element(product, overrides):
             warnings[f"{product.is_a()} with IsExternal = False: interior, classed other"] += 1
         if _has_parts(product):
-            continue  # a whole whose parts carry the geometry (curtain wall, roof)
-        wanted[product.id()] = IfcElement(product.GlobalId, product.is_a(),
-                                          product.Name or "", SemanticClass(label),
-                                          _declared_window_area_m2(product, unit_scale))
+            continue  # a whole whose parts carry the geometry (curtain wall, roof, window)
+        window = product if product.is_a("IfcWindow") else _aggregate_window(product)
+        wanted[product.id()] = IfcElement(
+            product.GlobalId, product.is_a(), product.Name or "", SemanticClass(label),
+            None if window is None else _declared_window_area_m2(window, unit_scale),
+            None if window is None else window.GlobalId,
+            "" if window is None else window.Name or "")
     if not wanted:
         raise ValueError(f"{path} has no building element with geometry (walls, slabs, ...)")
 
@@ -153,8 +162,14 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
         face_element.append(np.full(len(f), len(elements)))
         elements.append(element)
         n_vertices += len(v)
-    if not faces:
-        raise ValueError(f"{path}: IfcOpenShell could triangulate no element")
+    if len(skipped) > MAX_SKIPPED_FRACTION * len(wanted):
+        raise ValueError(
+            f"{path}: IfcOpenShell could triangulate only {len(elements)} of the {len(wanted)} "
+            f"elements with geometry; a truth without the other {len(skipped)} would be "
+            f"wrong. They are {_name_skipped(skipped)}; IfcOpenShell says for the first: "
+            f"{_triangulation_error(model, skipped[0], settings)}. Repair them in the "
+            "authoring tool and export again, or map them to skip with --ifc-classes "
+            '({"GlobalId": "skip"}) to import without them')
     f_all = np.concatenate(faces)
     labels = np.array([e.label for e in elements], dtype=np.uint8)[np.concatenate(face_element)]
     mesh = LabelledMesh(np.concatenate(vertices), f_all, labels, np.full(len(f_all), NO_FACADE))
@@ -189,6 +204,15 @@ def import_ifc(
     if config.up_axis != "z":
         raise ValueError("IFC models are z-up; leave --up-axis at z")
     model = read_ifc(path, overrides=overrides, progress=progress)
+    return building_from_ifc(model, path, building_id=building_id, config=config)
+
+
+def building_from_ifc(model: IfcModel, path: str | Path, *, building_id: str | None = None,
+                      config: ImportConfig | None = None) -> Building:
+    """The building of a triangulated IFC model (:func:`read_ifc`), as :func:`import_ifc`
+    derives it; ``path`` names the source in the truth and in errors."""
+    path = Path(path)
+    config = ImportConfig() if config is None else config
     warnings = dict(model.warnings)
     ground = _ground_record(model.ground, config)
     if config.ground_z_m is None:
@@ -200,7 +224,8 @@ def import_ifc(
                 warnings["storeys below the ground, not facade: " + ", ".join(
                     f"{name} ({z:+.2f} m)" for name, z in model.ground.below)] = 1
     if not (model.mesh.face_label == SemanticClass.ROOF).any():
-        warnings["no roof element: surfaces open to the sky count as seen from outside"] = 1
+        warnings["no roof element: a virtual flat lid at the top closes the model for the "
+                 "visibility test"] = 1
     try:
         building, parent = building_from_mesh(
             model.mesh, building_id=building_id if building_id is not None else path.stem,
@@ -227,14 +252,20 @@ def import_ifc(
 def _window_areas(model: IfcModel, building: Building, element_of_face: np.ndarray
                   ) -> list[dict]:
     """Each IfcWindow's declared OverallWidth x OverallHeight beside its measured area (m²):
-    the window-class faces of that element that belong to a facade."""
+    the window-class faces of that window (or of its parts) that belong to a facade."""
     mesh = building.mesh
     counted = (mesh.face_facade != NO_FACADE) & (mesh.face_label == SemanticClass.WINDOW)
     measured = np.bincount(element_of_face[counted], weights=mesh.face_areas_m2()[counted],
                            minlength=len(model.elements))
-    return [{"global_id": e.global_id, "name": e.name, "declared_area_m2": e.declared_area_m2,
-             "measured_area_m2": float(measured[i])}
-            for i, e in enumerate(model.elements) if e.ifc_type.startswith("IfcWindow")]
+    windows: dict[str, dict] = {}
+    for i, e in enumerate(model.elements):
+        if e.window_id is None:
+            continue
+        w = windows.setdefault(e.window_id, {
+            "global_id": e.window_id, "name": e.window_name,
+            "declared_area_m2": e.declared_area_m2, "measured_area_m2": 0.0})
+        w["measured_area_m2"] += float(measured[i])
+    return list(windows.values())
 
 
 def _ground_record(ground: GroundLevel | None, config: ImportConfig) -> dict:
@@ -262,6 +293,31 @@ def _declared_window_area_m2(product, unit_scale: float) -> float | None:
         return None
     w, h = product.OverallWidth, product.OverallHeight
     return None if w is None or h is None else float(w * h) * unit_scale ** 2
+
+
+def _name_skipped(skipped: list[IfcElement]) -> str:
+    named = [f"{e.ifc_type} {e.global_id} {e.name!r}" for e in skipped[:MAX_NAMED]]
+    more = f" and {len(skipped) - MAX_NAMED} more" if len(skipped) > MAX_NAMED else ""
+    return "; ".join(named) + more
+
+
+def _triangulation_error(model, element: IfcElement, settings) -> str:
+    """IfcOpenShell's own message for an element it could not triangulate."""
+    import ifcopenshell.geom
+
+    try:
+        ifcopenshell.geom.create_shape(settings, model.by_guid(element.global_id))
+    except Exception as exc:  # IfcOpenShell raises RuntimeError and others
+        return repr(exc)
+    return "no error, but no faces"
+
+
+def _aggregate_window(product):
+    """The IfcWindow that ``product`` is a part of (directly), or None."""
+    for rel in getattr(product, "Decomposes", None) or ():
+        if rel.is_a("IfcRelAggregates") and rel.RelatingObject.is_a("IfcWindow"):
+            return rel.RelatingObject
+    return None
 
 
 def _has_parts(product) -> bool:

@@ -149,7 +149,7 @@ def building_from_mesh(
         LabelledMesh(vertices, bodies.faces, mesh.face_label, mesh.face_facade), grade_z)
     exposure = exposed_faces(mesh, bodies.sheet[parent], grade_z, config)
     mesh, visible, raycaster = exposure.mesh, exposure.visible, exposure.raycaster
-    parent = kept[parent[exposure.parent]]
+    parent = np.where(exposure.lid, -1, kept[parent[np.maximum(exposure.parent, 0)]])
     vertices, faces = mesh.vertices_m, mesh.faces
     areas, normals = mesh.face_areas_m2(), mesh.face_normals()
     is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
@@ -166,13 +166,18 @@ def building_from_mesh(
         raise _no_facade_error(source, mesh, areas, candidate, visible, ground_z, config,
                                parent)
     face_facade = facade_ids_of_faces(groups, len(faces))
-    mesh = LabelledMesh(vertices, faces, mesh.face_label, face_facade)
+    labels = mesh.face_label
+    mesh = LabelledMesh(vertices, faces, labels, face_facade)
 
     facades = tuple(
         _facade_truth(i + 1, g, mesh, areas, normals) for i, g in enumerate(groups)
     )
-    height_m = float(vertices[:, 2].max()) - grade_z
+    height_m = float(mesh.triangles_m[~exposure.lid][:, :, 2].max()) - grade_z
     footprint = _footprint(source, raycaster, grade_z, ground_z, config, parent)
+    # The virtual lid of a roofless model served the rays and the footprint; the file's
+    # own faces remain.
+    mesh = LabelledMesh(vertices, faces[~exposure.lid], labels[~exposure.lid],
+                        face_facade[~exposure.lid])
     window, wall, door = (sum(getattr(f, k) for f in facades)
                           for k in ("window_area_m2", "wall_area_m2", "door_area_m2"))
     gross = gross_facade_area_m2(wall, window, door)
@@ -194,17 +199,18 @@ def building_from_mesh(
             "source_file": source.name,
             "offset_m": [float(x) for x in offset],
             "ground_z_m": ground_z,
-            "hidden_area_m2": _class_areas(mesh, areas, candidate & ~visible),
-            "below_grade_area_m2": _class_areas(mesh, areas, is_facade_class & ~candidate),
+            "hidden_area_m2": _class_areas(labels, areas, candidate & ~visible),
+            "below_grade_area_m2": _class_areas(labels, areas, is_facade_class & ~candidate),
             "unassigned_area_m2": _class_areas(
-                mesh, areas, visible & (face_facade == NO_FACADE)
+                labels, areas, visible & (face_facade == NO_FACADE)
             ),
-            "bodies": {**bodies.counts, "sheet_faces_turned": exposure.turned_sheets},
+            "bodies": {**bodies.counts, "sheet_faces_turned": exposure.turned_sheets,
+                       "virtual_lid": bool(exposure.lid.any())},
             "import_config": asdict(config),
             **(extra or {}),
         },
     )
-    return Building(mesh=mesh, truth=truth), parent
+    return Building(mesh=mesh, truth=truth), parent[~exposure.lid]
 
 
 def _footprint(source: Path, raycaster, grade_z: float, ground_z: float,
@@ -292,7 +298,5 @@ def _facade_truth(
     )
 
 
-def _class_areas(mesh: LabelledMesh, areas: np.ndarray, keep: np.ndarray) -> dict[str, float]:
-    return {
-        c.name.lower(): float(areas[keep & (mesh.face_label == c)].sum()) for c in FACADE_CLASSES
-    }
+def _class_areas(labels: np.ndarray, areas: np.ndarray, keep: np.ndarray) -> dict[str, float]:
+    return {c.name.lower(): float(areas[keep & (labels == c)].sum()) for c in FACADE_CLASSES}
