@@ -285,15 +285,19 @@ def test_agrees_with_the_generators_exact_truth(tmp_path):
     assert _iou(geojson_to_polygon(t.footprint), geojson_to_polygon(g.footprint)) >= 0.999
 
 
-def test_overlapping_boxes_give_the_union_footprint(tmp_path):
-    # Two closed boxes that overlap, one mesh without repairs: inside is their union.
-    a = trimesh.creation.box(bounds=[[0, 0, 0], [10, 8, 6]])
-    b = trimesh.creation.box(bounds=[[6, 4, 0], [14, 10, 4]])
-    both = trimesh.util.concatenate([a, b])
+def _two_boxes(tmp_path, a, b):
+    """The truth of two boxes (bounds ``a``, ``b``), all wall, imported as one PLY."""
+    both = trimesh.util.concatenate([trimesh.creation.box(bounds=a),
+                                     trimesh.creation.box(bounds=b)])
     n = len(both.faces)
     write_labelled_ply(tmp_path / "two.ply", LabelledMesh(
         both.vertices, both.faces, np.full(n, WALL), np.zeros(n, dtype=np.int32)))
-    t = import_labelled_mesh(tmp_path / "two.ply").truth
+    return import_labelled_mesh(tmp_path / "two.ply").truth
+
+
+def test_overlapping_boxes_give_the_union_footprint(tmp_path):
+    # Two closed boxes that overlap, one mesh without repairs: inside is their union.
+    t = _two_boxes(tmp_path, [[0, 0, 0], [10, 8, 6]], [[6, 4, 0], [14, 10, 4]])
     union = Polygon([(0, 0), (10, 0), (10, 4), (14, 4), (14, 10), (6, 10), (6, 8), (0, 8)])
     assert t.footprint_area_m2 == pytest.approx(union.area, rel=1e-9)  # 80 + 48 - 16
     shift = np.asarray(t.extra["offset_m"][:2])
@@ -307,14 +311,8 @@ def test_overlapping_boxes_are_clipped_where_they_pass_into_each_other(tmp_path)
     # repairs: A's east and north faces pass into B, B's south and west faces into A.
     # Union footprint 80 + 48 - 24 = 104 m²; its outline is a staircase whose perimeter is
     # the bounding box's, 2 (12 + 10) = 44 m, so the facade is 44 x 6 = 264 m² (kept or
-    # dropped whole, the faces half inside the other box gave 276 m²).
-    a = trimesh.creation.box(bounds=[[0, 0, 0], [10, 8, 6]])
-    b = trimesh.creation.box(bounds=[[4, 4, 0], [12, 10, 6]])
-    both = trimesh.util.concatenate([a, b])
-    n = len(both.faces)
-    write_labelled_ply(tmp_path / "two.ply", LabelledMesh(
-        both.vertices, both.faces, np.full(n, WALL), np.zeros(n, dtype=np.int32)))
-    t = import_labelled_mesh(tmp_path / "two.ply").truth
+    # dropped whole, the faces partly inside the other box gave 312 m² before).
+    t = _two_boxes(tmp_path, [[0, 0, 0], [10, 8, 6]], [[4, 4, 0], [12, 10, 6]])
     assert t.footprint_area_m2 == pytest.approx(104.0, rel=0.01)
     assert t.facade_area_m2 == pytest.approx(264.0, rel=0.01)
     assert sorted(round(f.width_m, 6) for f in t.facades) == [2, 2, 4, 4, 6, 8, 8, 10]

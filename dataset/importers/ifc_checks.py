@@ -3,14 +3,15 @@
 - :func:`elevation_areas`: orthographic views of the wall, window and door surfaces above
   the ground from :data:`ELEVATION_DIRECTIONS` horizontal directions; only those surfaces
   occlude (a wall behind a balcony or under the eaves counts), each surface is counted in
-  the direction nearest its normal, and points lying inside another solid are left out (a
-  ray from 5 mm in front of the point towards the viewer meets a face from behind: a gable
-  running into its roof slab). The facade, window and WWR an architect would measure on
+  the direction nearest its normal (one ray at a random point of each grid cell: no
+  aliasing with mullions), and points lying inside another solid are left out (a ray from
+  5 mm in front of the point towards the viewer meets a face from behind: a gable running
+  into its roof slab). The facade, window and WWR an architect would measure on
   elevation drawings -- against the importer's rays from every face over its hemisphere,
   cuts and facade grouping.
 - :func:`plan_footprint`: the union of the plan projections of the elements that stand at
-  the footprint height, gaps under 2 mm closed, holes filled -- against the importer's cross-section and inside
-  rule.
+  the footprint height, gaps under 2 mm closed, holes filled -- against the importer's
+  cross-section and inside rule.
 - the declared ``OverallWidth x OverallHeight`` of each IfcWindow is in the import's own
   record (``truth.extra["ifc"]["windows"]``).
 
@@ -38,6 +39,9 @@ ELEVATION_DIRECTIONS = 72
 PLAN_CLOSING_M = 1e-3
 """Gaps narrower than twice this between the plan projections of elements are closed."""
 INSIDE_PROBE_M = 0.005
+"""A counted point is probed this far in front of its surface for lying inside a solid."""
+JITTER_SEED = 0
+"""Seed of the elevation rays' positions within their grid cells (stratified sampling)."""
 """A counted point is probed this far in front of its surface for lying inside a solid."""
 
 
@@ -68,13 +72,16 @@ def elevation_areas(mesh: LabelledMesh, spacing_m: float = 0.1) -> dict:
     radius = float(np.linalg.norm(hi[:2] - lo[:2])) / 2 + 1.0
     zs = np.arange(max(lo[2], 0.0) + spacing_m / 2, hi[2], spacing_m)
     ts = np.arange(-radius, radius, spacing_m) + spacing_m / 2
-    grid_t, grid_z = np.meshgrid(ts, zs, indexing="ij")
+    grid_t, grid_z = (g.reshape(-1) for g in np.meshgrid(ts, zs, indexing="ij"))
+    rng = np.random.default_rng(JITTER_SEED)
     area = {c: 0.0 for c in FACADE_CLASSES}
     for k in range(ELEVATION_DIRECTIONS):
         d = np.array([np.cos(k * step), np.sin(k * step), 0.0])  # towards the viewer
         tangent = np.array([-d[1], d[0], 0.0])
-        origins = (centre + radius * d)[None, :] + grid_t.reshape(-1, 1) * tangent
-        origins[:, 2] = grid_z.reshape(-1)
+        # One ray at a random point of each grid cell: no aliasing with mullions or bricks.
+        jitter = (rng.random((len(grid_t), 2)) - 0.5) * spacing_m
+        origins = (centre + radius * d)[None, :] + (grid_t + jitter[:, 0])[:, None] * tangent
+        origins[:, 2] = grid_z + jitter[:, 1]
         face, t = caster.first_hit(origins, np.broadcast_to(-d, origins.shape).copy())
         counted = face >= 0
         counted[counted] = upright[face[counted]] & (face_bin[face[counted]] == k)
