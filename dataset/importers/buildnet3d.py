@@ -47,7 +47,7 @@ from dataset.core.mesh import LabelledMesh, write_labelled_ply
 from dataset.core.protocols import IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Frame, Scene
 from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.importers.buildnet3d_model import read_segmented_model
 from dataset.rendering.section import SNAP_GRID_M
 from dataset.scenes.images import (
@@ -319,22 +319,21 @@ def building_truth(walls: list[dict[str, Any]], building_id: str,
         height = float(d[2, 1] - d[2, 0])
         window = (wall["wwr"] * wall["area"] if model_window is None
                   else float(model_window[w + 1]))
-        gross = width * height
+        areas = ClassAreas(window, max(0.0, width * height - window), 0.0)
         facades.append(FacadeTruth(
             id=w + 1, normal=tuple(float(x) for x in wall["normal"]), width_m=width,
-            height_m=height, window_area_m2=window, wall_area_m2=gross - window,
-            door_area_m2=0.0, facade_area_m2=gross,
-            wwr=wwr_from_areas(window, gross - window, 0.0)))
+            height_m=height, window_area_m2=window, wall_area_m2=areas.wall_m2,
+            door_area_m2=0.0, facade_area_m2=areas.gross_m2, wwr=areas.wwr))
     window = sum(f.window_area_m2 for f in facades)
     wall_area = sum(f.wall_area_m2 for f in facades)
-    gross = gross_facade_area_m2(wall_area, window, 0.0)
+    areas = ClassAreas(window, wall_area, 0.0)
     z0 = min(float(w["domain"][2, 0]) for w in walls)
     height = max(float(w["domain"][2, 1]) for w in walls) - z0
     footprint = _footprint(walls)
     return BuildingTruth(
         id=building_id, type="imported", floors=max(1, round(height / 3.0)), height_m=height,
-        window_area_m2=window, facade_area_m2=gross, wall_area_m2=wall_area, door_area_m2=0.0,
-        wwr=wwr_from_areas(window, wall_area, 0.0), footprint=polygon_to_geojson(footprint),
+        window_area_m2=window, facade_area_m2=areas.gross_m2, wall_area_m2=wall_area,
+        door_area_m2=0.0, wwr=areas.wwr, footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area), facades=tuple(facades),
         extra={"source": "BuildNet3D-dataset wwr_information"
                + ("" if model is None else " and the segmented model's window faces"),

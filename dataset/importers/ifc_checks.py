@@ -29,7 +29,7 @@ from dataset.core.classes import FACADE_CLASSES, SemanticClass
 from dataset.core.footprint import geojson_to_polygon
 from dataset.core.mesh import LabelledMesh
 from dataset.core.truth import BuildingTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.importers.ifc_import import IfcModel
 from dataset.importers.import_config import ImportConfig
 from dataset.rendering.raycast import Raycaster
@@ -96,9 +96,9 @@ def elevation_areas(mesh: LabelledMesh, spacing_m: float = 0.1) -> dict:
             area[c] += float(weights[labels == c].sum())
     window, wall, door = (area[SemanticClass.WINDOW], area[SemanticClass.WALL],
                           area[SemanticClass.DOOR])
-    return {"facade_m2": gross_facade_area_m2(wall, window, door), "window_m2": window,
-            "wall_m2": wall, "door_m2": door,
-            "wwr": wwr_from_areas(window, wall, door) if wall + window + door > 0 else 0.0}
+    totals = ClassAreas(window, wall, door)
+    return {"facade_m2": totals.gross_m2, "window_m2": window, "wall_m2": wall,
+            "door_m2": door, "wwr": totals.wwr or 0.0}
 
 
 def plan_footprint(model: IfcModel, z_m: float):

@@ -3,11 +3,12 @@ truth.
 
 Steps (docs/importing.md): IfcOpenShell triangulates every product in world coordinates,
 openings subtracted, in metres (:func:`read_ifc`); each element's class comes from its
-entity (:mod:`dataset.importers.ifc_classes`); the ground is the lowest storey's floor; then the
-mesh importer derives the truth (:func:`dataset.importers.mesh_import.building_from_mesh`: touching
-and
-overlapping solids are normal, nothing below the ground counts). Each IfcWindow's declared
-OverallWidth x OverallHeight is listed beside its measured exterior area.
+entity (:mod:`dataset.importers.ifc_classes`); the ground is the storey at grade
+(:mod:`dataset.importers.ifc_ground`); then the mesh importer derives the truth
+(:func:`dataset.importers.mesh_import.building_from_mesh`: open, touching, overlapping and
+inside-out bodies are normal, nothing below the ground counts). Each IfcWindow's declared
+OverallWidth x OverallHeight is listed beside its measured exterior area. The model's north
+(:func:`north_of_ifc`) becomes the truth's ``north_deg``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from tqdm import tqdm
 
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.mesh import LabelledMesh
+from dataset.core.orientation import NorthSource
 from dataset.core.truth import Building
 from dataset.importers.ifc_classes import SKIP, class_of_element, interior_flagged_entities
 from dataset.importers.ifc_ground import GroundLevel, ground_level
@@ -70,6 +72,8 @@ class IfcModel:
         Elements IfcOpenShell could not triangulate.
     unit_scale : float
         Metres per file length unit.
+    north : (float, NorthSource) or None
+        :func:`north_of_ifc` of the file.
     """
 
     mesh: LabelledMesh
@@ -79,6 +83,7 @@ class IfcModel:
     warnings: dict[str, int]
     skipped: tuple[IfcElement, ...]
     unit_scale: float
+    north: tuple[float, NorthSource] | None = None
 
 
 def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool = True
@@ -175,7 +180,26 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
     mesh = LabelledMesh(np.concatenate(vertices), f_all, labels, np.full(len(f_all), NO_FACADE))
     return IfcModel(mesh, np.concatenate(face_element), tuple(elements),
                     ground_level(model, unit_scale),
-                    dict(sorted(warnings.items())), tuple(skipped), unit_scale)
+                    dict(sorted(warnings.items())), tuple(skipped), unit_scale,
+                    north_of_ifc(model))
+
+
+def north_of_ifc(model) -> tuple[float, NorthSource] | None:
+    """The north an IFC model states, as ``(north_deg, source)``; ``None`` if it states none.
+
+    ``north_deg`` is the clockwise angle from true north to the model's +y axis
+    (:mod:`dataset.core.orientation`), which is IfcOpenShell's anticlockwise angle
+    from project north to north. The geometric context's ``TrueNorth`` is used
+    when given, else the ``IfcMapConversion``'s grid north (IFC2X3: ePSet_MapConversion).
+    """
+    import ifcopenshell.util.geolocation as geolocation
+
+    contexts = model.by_type("IfcGeometricRepresentationContext", include_subtypes=False)
+    if any(c.TrueNorth is not None for c in contexts):
+        return float(geolocation.get_true_north(model)), "ifc_true_north"
+    if geolocation.get_helmert_transformation_parameters(model) is not None:
+        return float(geolocation.get_grid_north(model)), "ifc_map_conversion"
+    return None
 
 
 def import_ifc(
@@ -237,6 +261,10 @@ def building_from_ifc(model: IfcModel, path: str | Path, *, building_id: str | N
     except NoFootprintError as exc:
         raise ValueError(f"{exc}. Elements at that height: "
                          f"{_name_elements(model, exc.section_parents)}") from None
+    if model.north is not None:
+        north_deg, source = model.north
+        building = replace(building, truth=replace(building.truth, north_deg=north_deg,
+                                                   north_source=source))
     element_of_face = model.face_element[parent]
     building.truth.extra["ifc"] = {
         "elements": dict(sorted(Counter(e.label.name.lower() for e in model.elements).items())),
