@@ -57,7 +57,6 @@ def test_ifcopenshell_house_windows_made_of_parts(tmp_path_factory):
     _check_against_independent_measures(model, building, footprint_m2=53.4)
 
 
-@pytest.mark.slow
 def test_revit_duplex_with_a_foundation_storey(tmp_path_factory):
     """Revit 2011's duplex (refused before: 'the section at z = 0.050 m holds no solid'):
     the ground is storey 'Level 1' at 0.00, the foundation storey 'T/FDN' at -1.25 m is
