@@ -36,18 +36,20 @@ from typing import Any
 
 import cv2
 import numpy as np
+import shapely
 from shapely.geometry import LineString
 from shapely.ops import polygonize, unary_union
 
 from dataset.core.camera import Intrinsics, pixel_centres, unproject_depth_to_world
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
-from dataset.core.mesh import write_labelled_ply
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
 from dataset.core.protocols import IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Frame, Scene
 from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
 from dataset.core.wwr import ClassAreas
 from dataset.importers.buildnet3d_model import read_segmented_model
+from dataset.rendering.section import SNAP_GRID_M
 from dataset.scenes.images import (
     DEPTH_MAX_UNITS,
     read_rgb,
@@ -162,10 +164,11 @@ def import_building(root: Path, index: int, out_dir: Path) -> Scene:
     scene = write_scene_views(out_dir, views, [w["normal"] for w in walls],
                               {"source": "BuildNet3D-dataset", "source_building": index,
                                DEPTH_RELATIVE_STEP_KEY: HDR_RELATIVE_STEP})
-    write_building(out_dir / "building.json", building_truth(walls, f"building{index}"))
-    model = root / "model" / f"{index}_segmented.ply"
-    if model.is_file():
-        write_labelled_ply(out_dir / "mesh.ply", read_segmented_model(model, walls))
+    model_path = root / "model" / f"{index}_segmented.ply"
+    model = read_segmented_model(model_path, walls) if model_path.is_file() else None
+    write_building(out_dir / "building.json", building_truth(walls, f"building{index}", model))
+    if model is not None:
+        write_labelled_ply(out_dir / "mesh.ply", model)
     return scene
 
 
@@ -289,19 +292,38 @@ def facade_ids_from_walls(labels: np.ndarray, depth_z_m: np.ndarray, intrinsics:
     return out
 
 
-def building_truth(walls: list[dict[str, Any]], building_id: str) -> BuildingTruth:
-    """Our ``building.json`` truth from the generator's walls (no doors: it has none)."""
+def building_truth(walls: list[dict[str, Any]], building_id: str,
+                   model: LabelledMesh | None = None) -> BuildingTruth:
+    """Our ``building.json`` truth from the generator's walls (no doors: it has none).
+
+    A wall's gross facade is its rectangle, the horizontal extent of its ``domain`` times
+    its height: the generator's wall faces are whole rectangles with the window modules
+    set through them (its ``area`` is that rectangle, and its ``wwr`` window / gross like
+    ours); a wall cut around its windows has the same rectangle. Its window area is
+    ``wwr * area``, or, with the segmented ``model``, the area of the window faces on that
+    wall (:func:`dataset.importers.buildnet3d_model.facade_ids_of_faces`): the generator's
+    per-wall list can count a window on two walls (one that reaches across a neighbouring
+    wall's plane), its overall WWR counts it once, and so does the model. Opaque wall =
+    gross - window.
+    """
+    model_window = None
+    if model is not None:
+        on_window = model.face_label == SemanticClass.WINDOW
+        model_window = np.bincount(model.face_facade[on_window],
+                                   weights=model.face_areas_m2()[on_window],
+                                   minlength=len(walls) + 1)
     facades = []
     for w, wall in enumerate(walls):
         d = wall["domain"]
-        window = wall["wwr"] * wall["area"]
-        areas = ClassAreas(window, wall["area"], 0.0)
+        width = float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0]))
+        height = float(d[2, 1] - d[2, 0])
+        window = (wall["wwr"] * wall["area"] if model_window is None
+                  else float(model_window[w + 1]))
+        areas = ClassAreas(window, max(0.0, width * height - window), 0.0)
         facades.append(FacadeTruth(
-            id=w + 1, normal=tuple(float(x) for x in wall["normal"]),
-            width_m=float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0])),
-            height_m=float(d[2, 1] - d[2, 0]), window_area_m2=window,
-            wall_area_m2=wall["area"], door_area_m2=0.0, facade_area_m2=areas.gross_m2,
-            wwr=areas.wwr))
+            id=w + 1, normal=tuple(float(x) for x in wall["normal"]), width_m=width,
+            height_m=height, window_area_m2=window, wall_area_m2=areas.wall_m2,
+            door_area_m2=0.0, facade_area_m2=areas.gross_m2, wwr=areas.wwr))
     window = sum(f.window_area_m2 for f in facades)
     wall_area = sum(f.wall_area_m2 for f in facades)
     areas = ClassAreas(window, wall_area, 0.0)
@@ -313,7 +335,9 @@ def building_truth(walls: list[dict[str, Any]], building_id: str) -> BuildingTru
         window_area_m2=window, facade_area_m2=areas.gross_m2, wall_area_m2=wall_area,
         door_area_m2=0.0, wwr=areas.wwr, footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area), facades=tuple(facades),
-        extra={"source": "BuildNet3D-dataset wwr_information",
+        extra={"source": "BuildNet3D-dataset wwr_information"
+               + ("" if model is None else " and the segmented model's window faces"),
+               "generator_wall_window_area_m2": [w["wwr"] * w["area"] for w in walls],
                "generator_overall_wwr": walls[0]["overall_wwr"],
                "floors_estimated_from_height_3m": True, "ground_z_m": z0})
 
@@ -327,7 +351,8 @@ def _footprint(walls: list[dict[str, Any]]):
         c = wall["center"][:2]
         half = 0.5 * float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0]))
         lines.append(LineString([c - half * along, c + half * along]))
-    faces = list(polygonize(unary_union(lines)))
+    # The generator's coordinates are float32 (-1.4999998807907104 for -1.5): snap the ends.
+    faces = list(polygonize(shapely.set_precision(unary_union(lines), SNAP_GRID_M)))
     if not faces:
         raise ValueError("the walls of wwr_information do not close a footprint")
     return unary_union(faces)

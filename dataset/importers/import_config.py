@@ -70,8 +70,8 @@ class ImportConfig:
 _HELP = {
     "up_axis": "the file's up axis; glTF from Blender is y",
     "ground_z_m": "ground level in the file (metres, after --up-axis): what lies below is "
-                  "underground, never facade (default: the lowest point; IFC: the lowest "
-                  "storey's floor)",
+                  "underground, never facade (default: the lowest point; IFC: the storey at "
+                  "grade, docs/importing.md)",
     "max_tilt_deg": "faces tilted further than this from upright are no facade",
     "angle_tolerance_deg": "faces within this angle of a facade's direction join it",
     "offset_tolerance_m": "parallel planes closer than this are one facade",
