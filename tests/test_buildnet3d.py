@@ -21,7 +21,7 @@ from dataset.generate import main as generate_main
 from dataset.rendering.render import render_view
 from dataset.scenes.images import read_depth_m, read_facade_ids
 from dataset.scenes.labels import class_mapping
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input, read_scene
 from dataset.scenes.scene_validation import read_frame_labels
 
 GEN = dict(zip(class_mapping("generator").names, class_mapping("generator").colours))
@@ -165,9 +165,11 @@ def test_2dss_ideal_wwr_within_2_percent_of_the_generators(imported):
     of rows (measured 0.211)."""
     scene, _, _, _ = imported
     assert scene.extra["depth_relative_step"] == 1 / 128
-    result = run_2dss(scene, "ideal")
+    view = read_method_input(scene.root)
+    assert view.depth_relative_step == 1 / 128
+    result = run_2dss(view, "ideal")
     assert result.wwr == pytest.approx(scene.building.wwr, rel=0.02), result.wwr
-    exact = dataclasses.replace(scene, extra={})
+    exact = dataclasses.replace(view, depth_relative_step=0.0)
     assert run_2dss(exact, "ideal").wwr > 1.2 * scene.building.wwr
 
 
