@@ -8,7 +8,7 @@ the file: it checks the structure and gives typed records
 (:class:`MetaData`, :class:`MetaDataFrame`); what a layout makes of them is its reader's:
 :func:`dataset.importers.meta_data.read_meta_data` (sdfstudio / dataparser -> a scene),
 :mod:`dataset.importers.blenderproc`, :mod:`dataset.importers.buildnet3d`.
-:func:`read_json_file` is the one JSON reader of the importers' source files.
+:func:`read_json_file` reads every JSON file of the official layouts.
 """
 
 from __future__ import annotations
@@ -72,7 +72,7 @@ class MetaData:
 def read_json_file(path: Path, missing: str = "", *, what: str = "valid JSON") -> Any:
     """The JSON value in ``path``; ``ValueError`` if it is missing (``missing`` says why that
     matters) or not JSON (``what`` names what it should be). The one JSON reader of the
-    importers' source files."""
+    official layouts' files."""
     if not path.is_file():
         raise ValueError(f"{path} does not exist{missing}")
     try:
