@@ -199,7 +199,7 @@ def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[Fa
     """Per-facade errors of a result, one row per truth facade the result names.
 
     Under the ideal and multi protocols the result's facade ids are the truth's
-    (each view carries its facade id). Other results (neural3d) number their
+    (each view carries its facade id). Other results (a mesh's facades) number their
     own facades; when every estimate carries ``normal`` and ``centre_m`` they
     are matched to the truth's facades by :func:`metrics.facade_match.match_facades`,
     and each estimate that faces no truth facade gives a failed row with

@@ -21,6 +21,7 @@ from dataset.core.protocols import IDEAL_PROTOCOL
 from dataset.core.semantic_ply import read_semantic_ply
 from metrics.aggregate import Summary, family_rank, method_rank, protocol_rank
 from metrics.errors import BuildingErrors
+from metrics.html_orientation import orientation_section
 from metrics.html_sections import (
     PAGE_CSS,
     PAGE_JS,
@@ -82,7 +83,8 @@ def build_report(out_dir: Path) -> str:
         f"<h1>envelope-bench comparison</h1><p>{esc(provenance.get('produced_by', ''))}</p>"
         f'<div id="overview"><h2>Table 2: errors per family</h2>{table2_html(table2)}'
         f"<h2>Table 3: footprint IoU</h2>{table3_html(table3)}"
-        f"<h2>Charts</h2>{errors_chart(table2)}{iou_chart(rows)}</div>"
+        f"<h2>Charts</h2>{errors_chart(table2)}{iou_chart(rows)}"
+        f"{orientation_section(out_dir)}</div>"
         f'<h2>Buildings</h2><p>Click a building to see its details.</p>'
         f'<nav class="buildings">{nav}</nav>{buildings}{provenance_footer(provenance)}'
     )
@@ -256,7 +258,7 @@ def _footprints(scene: str, scene_dir: Path, out_dir: Path) -> str:
 
 
 def _mesh_viewer(scene: str, out_dir: Path) -> str:
-    """The semantic meshes of ``scene`` (decimated; ``<method>_runs.json``, neural3d's), drawn
+    """The semantic meshes of ``scene`` (decimated; each ``<method>_runs.json``), drawn
     when the building is opened."""
     return "".join(_one_mesh(run, i) for i, run in enumerate(
         r for r in read_mesh_pointers(out_dir) if r.scene == scene))
@@ -300,7 +302,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m metrics.html_report",
         description="(Re)make report.html, one self-contained offline page with the tables, "
-        "interactive charts, per-building details and the neural3d mesh viewer, from the output "
+        "interactive charts, per-building details and the mesh viewer, from the output "
         "folder of `python -m metrics.compare`.")
     parser.add_argument("--out", type=Path, required=True,
                         help="the comparison's output folder (its --out); report.html goes there")

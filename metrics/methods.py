@@ -1,37 +1,29 @@
 """The methods the comparison runs, all through :class:`dataset.core.method.Method`.
 
-The built-in ones (2D-S, 2D-SS in :mod:`baselines.methods`, neural3d in
-:mod:`neural3d.method`) are found by where they are declared; any other name is
-looked up among the installed plugins (entry point group
-``envelope_bench.methods``). Each becomes a :class:`~metrics.runner.MethodSpec`
-whose ``run`` reads a scene folder as the method's
-:class:`~dataset.core.method_input.MethodInput` (no truth: metrics alone reads
-``building.json``) and returns the method's result. A built-in
+The built-in ones are found where :data:`dataset.core.method.BUILT_IN` says
+they are declared; any other name is looked up among the installed plugins
+(entry point group ``envelope_bench.methods``). Each becomes a
+:class:`~metrics.runner.MethodSpec` whose ``run`` reads a scene folder as the
+method's :class:`~dataset.core.method_input.MethodInput` (no truth: metrics alone
+reads ``building.json``) and returns the method's result. A built-in
 method whose package cannot be imported still gets a spec: its runs fail with
 the import error as the reason, and the other methods go on.
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Mapping
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-from dataset.core.method import Method, installed_methods
+from dataset.core.method import BUILT_IN, Method, built_in_method, installed_methods
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.core.results import MethodResult
 from dataset.executors.ray_tasks import TaskResources
 from dataset.scenes.scene import read_method_input
 from metrics.runner import MethodSpec
 
-# name -> (module, attribute) of the built-in methods' declarations, in table order.
-BUILT_IN: dict[str, tuple[str, str]] = {
-    "2D-S": ("baselines.methods", "METHOD_2DS"),
-    "2D-SS": ("baselines.methods", "METHOD_2DSS"),
-    "neural3d": ("neural3d.method", "METHOD_NEURAL3D"),
-}
 METHODS: tuple[str, ...] = tuple(BUILT_IN)
 
 
@@ -61,12 +53,6 @@ def method_specs(
             continue
         specs.append(spec_from_method(method, views, results_dir, configs.get(name)))
     return specs
-
-
-def built_in_method(name: str) -> Method:
-    """The built-in method ``name`` (imports its package; may raise ``ImportError``)."""
-    module, attribute = BUILT_IN[name]
-    return getattr(importlib.import_module(module), attribute)
 
 
 def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,

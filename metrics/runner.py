@@ -51,7 +51,7 @@ class MethodSpec:
     result JSON; ``has_footprint`` says whether it estimates a footprint;
     ``resources`` what one run reserves on a cluster node. ``artefacts_dir``:
     where ``run`` writes a folder per scene (named by the scene) that the
-    comparison keeps (neural3d's run folder); such a ``run`` also takes an
+    comparison keeps (a trained method's run folder); such a ``run`` also takes an
     ``artefacts_dir=`` keyword to write it elsewhere (a worker on another machine).
     ``mesh_file``: a semantic mesh inside a scene's artefacts folder, for the
     figures and the report; ``heavy``: run only at the highest severity of a

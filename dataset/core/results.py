@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from dataset.core.atomic import write_json_atomic
+from dataset.core.orientation import OrientationBin, orientation_bin
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.core.provenance import Provenance, code_version
 
@@ -33,6 +34,9 @@ class FacadeEstimate:
     the facade's surface) are in the world frame, for methods whose ids are
     their own (neural3d): evaluation matches such facades to the truth's by
     them (:mod:`metrics.facade_match`). ``None`` where the method does not say.
+    ``azimuth_deg`` is the facade's outward azimuth, degrees clockwise from true
+    north (:mod:`dataset.core.orientation`); methods leave it ``None`` (they do not
+    know north) and evaluation fills it (:mod:`metrics.export_table`).
     """
 
     id: int
@@ -46,6 +50,12 @@ class FacadeEstimate:
     reason: str = ""
     normal: tuple[float, float, float] | None = None
     centre_m: tuple[float, float, float] | None = None
+    azimuth_deg: float | None = None
+
+    @property
+    def orientation(self) -> OrientationBin | None:
+        """EnergyPlus bin (N, E, S, W) of ``azimuth_deg``; ``None`` without one."""
+        return None if self.azimuth_deg is None else orientation_bin(self.azimuth_deg)
 
     @staticmethod
     def from_json_dict(d: dict[str, Any]) -> FacadeEstimate:

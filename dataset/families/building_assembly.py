@@ -16,7 +16,7 @@ from shapely.geometry import Polygon
 from dataset.core.footprint import polygon_to_geojson
 from dataset.core.mesh import MERGE_DECIMALS
 from dataset.core.truth import Building, BuildingTruth, BuildingType, FacadeTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.families.facade_geometry import WallSpec, wall_faces
 from dataset.families.polygon_mesh import PlanarFace, triangulate_faces
 
@@ -55,7 +55,7 @@ def facade_truths(
         window = sum(w.opening_area_m2("window") for w in group)
         door = sum(w.opening_area_m2("door") for w in group)
         wall = sum(w.wall_area_m2() for w in group)
-        gross = gross_facade_area_m2(wall, window, door)
+        areas = ClassAreas(window, wall, door)
         normal = sum(w.frame.length_m * w.frame.normal for w in group)
         normal = normal / np.linalg.norm(normal)
         out.append(
@@ -67,8 +67,8 @@ def facade_truths(
                 window_area_m2=float(window),
                 wall_area_m2=float(wall),
                 door_area_m2=float(door),
-                facade_area_m2=gross,
-                wwr=wwr_from_areas(window, wall, door),
+                facade_area_m2=areas.gross_m2,
+                wwr=areas.wwr,
                 curved=fid in curved_facade_ids,
             )
         )
@@ -112,7 +112,7 @@ def assemble_building(
     window = sum(f.window_area_m2 for f in facades)
     door = sum(f.door_area_m2 for f in facades)
     wall = sum(f.wall_area_m2 for f in facades)
-    gross = gross_facade_area_m2(wall, window, door)
+    areas = ClassAreas(window, wall, door)
     footprint = Polygon(footprint_xy)
     truth = BuildingTruth(
         id=building_id,
@@ -120,10 +120,10 @@ def assemble_building(
         floors=int(floors),
         height_m=float(height_m),
         window_area_m2=float(window),
-        facade_area_m2=gross,
+        facade_area_m2=areas.gross_m2,
         wall_area_m2=float(wall),
         door_area_m2=float(door),
-        wwr=wwr_from_areas(window, wall, door),
+        wwr=areas.wwr,
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,

@@ -47,7 +47,7 @@ from dataset.core.mesh import write_labelled_ply
 from dataset.core.protocols import IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Frame, Scene
 from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.importers.buildnet3d_model import read_segmented_model
 from dataset.importers.meta_data_file import META_DATA_FILE, read_json_file, read_meta_data_file
 from dataset.importers.source import NoOptions, SceneEntry, Source
@@ -293,23 +293,23 @@ def building_truth(walls: list[dict[str, Any]], building_id: str) -> BuildingTru
     for w, wall in enumerate(walls):
         d = wall["domain"]
         window = wall["wwr"] * wall["area"]
-        gross = gross_facade_area_m2(wall["area"], window, 0.0)
+        areas = ClassAreas(window, wall["area"], 0.0)
         facades.append(FacadeTruth(
             id=w + 1, normal=tuple(float(x) for x in wall["normal"]),
             width_m=float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0])),
             height_m=float(d[2, 1] - d[2, 0]), window_area_m2=window,
-            wall_area_m2=wall["area"], door_area_m2=0.0, facade_area_m2=gross,
-            wwr=wwr_from_areas(window, wall["area"], 0.0)))
+            wall_area_m2=wall["area"], door_area_m2=0.0, facade_area_m2=areas.gross_m2,
+            wwr=areas.wwr))
     window = sum(f.window_area_m2 for f in facades)
     wall_area = sum(f.wall_area_m2 for f in facades)
-    gross = gross_facade_area_m2(wall_area, window, 0.0)
+    areas = ClassAreas(window, wall_area, 0.0)
     z0 = min(float(w["domain"][2, 0]) for w in walls)
     height = max(float(w["domain"][2, 1]) for w in walls) - z0
     footprint = _footprint(walls)
     return BuildingTruth(
         id=building_id, type="imported", floors=max(1, round(height / 3.0)), height_m=height,
-        window_area_m2=window, facade_area_m2=gross, wall_area_m2=wall_area, door_area_m2=0.0,
-        wwr=wwr_from_areas(window, wall_area, 0.0), footprint=polygon_to_geojson(footprint),
+        window_area_m2=window, facade_area_m2=areas.gross_m2, wall_area_m2=wall_area,
+        door_area_m2=0.0, wwr=areas.wwr, footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area), facades=tuple(facades),
         extra={"source": "BuildNet3D-dataset wwr_information",
                "generator_overall_wwr": walls[0]["overall_wwr"],

@@ -7,7 +7,8 @@ entity (:mod:`dataset.importers.ifc_classes`); the ground is the lowest storey's
 mesh importer derives the truth (:func:`dataset.importers.mesh_import.building_from_mesh`: touching
 and
 overlapping solids are normal, nothing below the ground counts). Each IfcWindow's declared
-OverallWidth x OverallHeight is listed beside its measured exterior area.
+OverallWidth x OverallHeight is listed beside its measured exterior area. The model's north
+(:func:`north_of_ifc`) becomes the truth's ``north_deg``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from tqdm import tqdm
 
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.mesh import LabelledMesh
+from dataset.core.orientation import NorthSource
 from dataset.core.truth import Building
 from dataset.importers.ifc_classes import SKIP, class_of_element
 from dataset.importers.import_config import ImportConfig
@@ -59,6 +61,8 @@ class IfcModel:
         Elements IfcOpenShell could not triangulate.
     unit_scale : float
         Metres per file length unit.
+    north : (float, NorthSource) or None
+        :func:`north_of_ifc` of the file.
     """
 
     mesh: LabelledMesh
@@ -68,6 +72,7 @@ class IfcModel:
     warnings: dict[str, int]
     skipped: tuple[IfcElement, ...]
     unit_scale: float
+    north: tuple[float, NorthSource] | None = None
 
 
 def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool = True
@@ -155,7 +160,26 @@ def read_ifc(path: str | Path, *, overrides: dict | None = None, progress: bool 
                for s in model.by_type("IfcBuildingStorey") if s.ObjectPlacement is not None]
     ground = float(min(storeys)) * unit_scale if storeys else None
     return IfcModel(mesh, np.concatenate(face_element), tuple(elements), ground,
-                    dict(sorted(warnings.items())), tuple(skipped), unit_scale)
+                    dict(sorted(warnings.items())), tuple(skipped), unit_scale,
+                    north_of_ifc(model))
+
+
+def north_of_ifc(model) -> tuple[float, NorthSource] | None:
+    """The north an IFC model states, as ``(north_deg, source)``; ``None`` if it states none.
+
+    ``north_deg`` is the clockwise angle from true north to the model's +y axis
+    (:mod:`dataset.core.orientation`), which is IfcOpenShell's anticlockwise angle
+    from project north to north. The geometric context's ``TrueNorth`` is used
+    when given, else the ``IfcMapConversion``'s grid north (IFC2X3: ePSet_MapConversion).
+    """
+    import ifcopenshell.util.geolocation as geolocation
+
+    contexts = model.by_type("IfcGeometricRepresentationContext", include_subtypes=False)
+    if any(c.TrueNorth is not None for c in contexts):
+        return float(geolocation.get_true_north(model)), "ifc_true_north"
+    if geolocation.get_helmert_transformation_parameters(model) is not None:
+        return float(geolocation.get_grid_north(model)), "ifc_map_conversion"
+    return None
 
 
 def import_ifc(
@@ -193,6 +217,10 @@ def import_ifc(
         model.mesh, building_id=building_id if building_id is not None else path.stem,
         source=path, config=config, require_closed=False,
     )
+    if model.north is not None:
+        north_deg, source = model.north
+        building = replace(building, truth=replace(building.truth, north_deg=north_deg,
+                                                   north_source=source))
     open_edges = building.truth.extra["open_edges"]
     if open_edges["open"] or open_edges["misoriented"]:
         warnings["edges not closed or oppositely oriented (counted once per edge)"] = (

@@ -23,7 +23,7 @@ from dataset.core.classes import FACADE_CLASSES, NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
 from dataset.core.mesh import LabelledMesh
 from dataset.core.truth import Building, BuildingTruth, FacadeTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.importers.contact import split_touching_faces
 from dataset.importers.facade_grouping import FacadeGroup, facade_ids_of_faces, group_facades
 from dataset.importers.grade import edge_balance, split_at_height
@@ -169,17 +169,17 @@ def building_from_mesh(
     footprint = cross_section_footprint(raycaster, grade_z + config.footprint_height_m)
     window, wall, door = (sum(getattr(f, k) for f in facades)
                           for k in ("window_area_m2", "wall_area_m2", "door_area_m2"))
-    gross = gross_facade_area_m2(wall, window, door)
+    totals = ClassAreas(window, wall, door)
     truth = BuildingTruth(
         id=building_id,
         type="imported",
         floors=max(1, round(height_m / config.floor_height_m)),
         height_m=height_m,
         window_area_m2=window,
-        facade_area_m2=gross,
+        facade_area_m2=totals.gross_m2,
         wall_area_m2=wall,
         door_area_m2=door,
-        wwr=wwr_from_areas(window, wall, door),
+        wwr=totals.wwr,
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,
@@ -267,7 +267,8 @@ def _facade_truth(
     }
     window, wall, door = (by_class[SemanticClass.WINDOW], by_class[SemanticClass.WALL],
                           by_class[SemanticClass.DOOR])
-    gross = gross_facade_area_m2(wall, window, door)
+    facade_areas = ClassAreas(window, wall, door)
+    gross = facade_areas.gross_m2
     z = mesh.triangles_m[f][:, :, 2]
     height = float(z.max() - z.min())
     h = normals[f, :2] / np.linalg.norm(normals[f, :2], axis=1, keepdims=True)
@@ -284,7 +285,7 @@ def _facade_truth(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross,
-        wwr=wwr_from_areas(window, wall, door),
+        wwr=facade_areas.wwr,
         curved=curved,
     )
 
