@@ -3,8 +3,9 @@
 The built-in ones are found where :data:`dataset.core.method.BUILT_IN` says
 they are declared; any other name is looked up among the installed plugins
 (entry point group ``envelope_bench.methods``). Each becomes a
-:class:`~metrics.runner.MethodSpec` whose ``run`` reads a scene folder and
-returns the method's result. A built-in
+:class:`~metrics.runner.MethodSpec` whose ``run`` reads a scene folder as the
+method's :class:`~dataset.core.method_input.MethodInput` (no truth: metrics alone
+reads ``building.json``) and returns the method's result. A built-in
 method whose package cannot be imported still gets a spec: its runs fail with
 the import error as the reason, and the other methods go on.
 """
@@ -21,7 +22,7 @@ from dataset.core.method import BUILT_IN, Method, built_in_method, installed_met
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.core.results import MethodResult
 from dataset.executors.ray_tasks import TaskResources
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input
 from metrics.runner import MethodSpec
 
 METHODS: tuple[str, ...] = tuple(BUILT_IN)
@@ -97,13 +98,14 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
 
 def _run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
                    **artefacts_dir: Path) -> MethodResult:
-    return method.run(read_scene(scene_dir), protocol, config, **artefacts_dir)
+    return method.run(read_method_input(scene_dir, method.inputs), protocol, config,
+                      **artefacts_dir)
 
 
 def _debug_images_of_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
                             folder: Path) -> None:
     assert method.debug_images is not None
-    method.debug_images(read_scene(scene_dir), protocol, config, folder)
+    method.debug_images(read_method_input(scene_dir, method.inputs), protocol, config, folder)
 
 
 def list_methods() -> list[str]:

@@ -16,10 +16,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from dataset.core.method import Method
+from dataset.core.method_input import MethodInput, require_method_input
 from dataset.core.method_options import Option
 from dataset.core.protocols import TRAIN_PROTOCOL
 from dataset.core.results import MethodResult
-from dataset.core.scene_record import Scene, scene_name
+from dataset.core.scene_record import scene_name
 from neural3d.config import TrainConfig, config_to_dict, preset_config
 from neural3d.extraction.extract_config import ExtractConfig
 
@@ -123,7 +124,7 @@ def _budget_record(budget: Neural3dBudget) -> dict[str, Any]:
     }
 
 
-def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
+def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
                  artefacts_dir: Path) -> MethodResult:
     """Train for ``budget.steps`` steps (``neural3d.train``) into ``artefacts_dir / <scene>``,
     then extract (``neural3d.extract``) into its ``extract`` folder.
@@ -136,6 +137,7 @@ def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
     time cap cut training short, and, when training was reused, says so in ``warnings``
     with ``wall_time_s`` = the stored training and evaluation seconds + this extraction.
     """
+    require_method_input(scene, "neural3d")
     import torch
 
     # isort sees a module as first-party only once its file exists: keep this block as is.

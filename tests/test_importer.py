@@ -333,7 +333,7 @@ def test_generate_mesh_takes_every_import_option(tmp_path):
     from dataclasses import fields
 
     from dataset.generate import _parse_args
-    from dataset.importers.import_config import import_config_from_args
+    from dataset.source_args import import_config_from_args
 
     args = _parse_args(["--mesh", "m.ply", "--out", str(tmp_path), "--ground-z", "0.5",
                         "--up-axis", "y", "--footprint-height-m", "0.2", "--keep-position",
