@@ -14,10 +14,10 @@ on exact and on predicted masks, and per family the means.
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from tqdm import tqdm
@@ -35,37 +35,43 @@ from segment.segmenter import DEFAULT_NAME, Segmenter, resolve_segmenter
 CONFIG_KEY = "masks"
 PREDICTED = "predicted"
 TABLE_NAME = "exact_vs_predicted"
-CompareFn = Callable[..., object]
-"""``metrics.compare.compare``: ``(data, specs, results, out, **options) -> Comparison``."""
+CompareFn = Callable[..., Any]
+"""``metrics.compare.compare``: ``(data, specs, results, out, **options) -> Comparison``
+(passed in: ``metrics.compare`` imports this module, not the other way round)."""
 
 
-def add_masks_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--masks predicted[:MODEL]`` and ``--masks-threads`` of ``metrics.compare``."""
-    parser.add_argument(
-        "--masks", metavar="predicted[:MODEL]",
-        help="compare on a segmenter's masks instead of the exact ones (truth unchanged): "
-        "'predicted' uses the committed segmenter (segment/weights/default.pt), "
-        "'predicted:FILE.pt' other weights, 'predicted:NAME' an installed plugin "
-        "(entry point group envelope_bench.segmenters). The exact-mask comparison runs too; "
-        "masks are cached in <data>-masks/, results go to <results>/masks/, outputs to "
-        "<out>-masks-<key> with the table exact_vs_predicted. See docs/segment.md")
-    parser.add_argument("--masks-threads", type=int, default=2,
-                        help="torch threads of the segmenter (default: 2)")
+@dataclass(frozen=True)
+class MasksRequest:
+    """``--masks predicted[:MODEL]``: the segmenter (``model``: ``None`` for the committed
+    weights, a weights file ``*.pt`` or an installed plugin's name) and its torch threads."""
+
+    model: str | None = None
+    threads: int = 2
+
+    def __post_init__(self) -> None:
+        if self.threads < 1:
+            raise ValueError(f"--masks-threads must be >= 1, got {self.threads}")
 
 
-def parse_masks(text: str) -> str | None:
-    """``"predicted"`` -> ``None`` (the default segmenter), ``"predicted:MODEL"`` -> MODEL.
+def parse_masks(text: str, threads: int = 2) -> MasksRequest:
+    """``"predicted"`` -> the default segmenter, ``"predicted:MODEL"`` -> MODEL.
 
     Raises
     ------
     ValueError
-        For anything else.
+        For anything else, or ``threads`` < 1.
     """
     kind, sep, model = text.partition(":")
     if kind.strip() != PREDICTED or (sep and not model.strip()):
         raise ValueError(f"--masks {text!r}: write 'predicted' or 'predicted:MODEL' (MODEL: a "
                          f"weights file *.pt or an installed segmenter plugin's name)")
-    return model.strip() or None
+    return MasksRequest(model.strip() or None, threads)
+
+
+def masks_segmenter(request: MasksRequest) -> Segmenter:
+    """The segmenter ``request`` names, loaded (refused weights or plugins raise
+    ``ValueError`` here, before anything runs)."""
+    return resolve_segmenter(request.model, threads=request.threads)
 
 
 def masks_key(segmenter: Segmenter) -> str:
@@ -119,23 +125,23 @@ def with_predicted_masks(specs: Sequence[MethodSpec], segmenter: Segmenter) -> l
 
 
 def compare_on_predicted_masks(
-    masks: str, data: Path, results: Path, out: Path,
-    specs_for: Callable[[Path], list[MethodSpec]], compare: CompareFn, *, threads: int = 2,
+    segmenter: Segmenter, data: Path, results: Path, out: Path,
+    specs_for: Callable[[Path], list[MethodSpec]], compare: CompareFn, *, command: str,
     **options,
-) -> Table:
-    """Compare on exact masks and on ``masks``' predictions; write and return the table
-    :data:`TABLE_NAME` (``options`` go to ``compare``)."""
-    segmenter = resolve_segmenter(parse_masks(masks), threads=threads)
-    exact = compare(data, specs_for(results), results, out, **options)
+) -> tuple[Table, PredictedRun]:
+    """Compare on exact masks and on ``segmenter``'s; write the table :data:`TABLE_NAME`
+    into the predicted run's ``out`` and return it with the run's folders (``options``
+    go to ``compare``; ``specs_for(results folder)`` makes the methods' specs)."""
+    exact = compare(data, specs_for(results), results, out, command=command, **options)
     run = predicted_run(data, results, out, segmenter)
     predicted = compare(run.data, with_predicted_masks(specs_for(run.results), segmenter),
-                        run.results, run.out, **options)
+                        run.results, run.out, command=command, **options)
     exact_dirs = {d.name: d for d in find_scenes(data)}
     ious = [masks_scene_iou(read_scene(exact_dirs[d.name]), read_scene(d))
             for d in find_scenes(run.data) if d.name in exact_dirs]
     table = exact_vs_predicted_table(exact.rows, predicted.rows, ious, segmenter.name)
-    write_table(table, run.out, f"produced by metrics.compare --masks {masks}")
-    return table
+    write_table(table, run.out, f"produced by `{command}`")
+    return table, run
 
 
 def exact_vs_predicted_table(exact: Sequence[BuildingErrors], predicted: Sequence[BuildingErrors],

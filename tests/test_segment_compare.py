@@ -11,14 +11,19 @@ from segment_plugin import install_toy_plugin
 
 from metrics.compare import main
 from metrics.errors import BuildingErrors
-from metrics.predicted_masks import exact_vs_predicted_table, masks_key, parse_masks
+from metrics.predicted_masks import (
+    MasksRequest,
+    exact_vs_predicted_table,
+    masks_key,
+    parse_masks,
+)
 from segment.evaluate import SceneIou
 from segment.segmenter import Segmenter
 
 
 def test_masks_text_is_parsed_or_refused():
-    assert parse_masks("predicted") is None
-    assert parse_masks("predicted:my.pt") == "my.pt"
+    assert parse_masks("predicted") == MasksRequest(None, 2)
+    assert parse_masks("predicted:my.pt", threads=1) == MasksRequest("my.pt", 1)
     for bad in ("exact", "predicted:", "predict", ""):
         with pytest.raises(ValueError, match="write 'predicted' or 'predicted:MODEL'"):
             parse_masks(bad)
@@ -86,8 +91,11 @@ def test_bad_masks_options_are_refused_before_anything_runs(one_scene, tmp_path,
     corrupt.write_bytes(b"\x00" * 100)
     code, err = _run([*base, "--masks", f"predicted:{corrupt}"], capsys)
     assert code == 2 and "not a readable segmenter weights file" in err
-    code, err = _run([*base, "--masks", "predicted", "--degrade", "mask_noise"], capsys)
-    assert code == 2 and "cannot be combined" in err
+    with pytest.raises(SystemExit) as exit_info:  # the comparison's modes exclude each other
+        _run([*base, "--masks", "predicted", "--degrade", "mask_noise"], capsys)
+    assert exit_info.value.code == 2 and "not allowed with argument" in capsys.readouterr().err
+    code, err = _run([*base, "--masks", "predicted", "--masks-threads", "0"], capsys)
+    assert code == 2 and "--masks-threads must be >= 1" in err
     assert not (tmp_path / "data-masks").exists() and not (tmp_path / "r").exists()
 
 

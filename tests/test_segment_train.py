@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from dataset.core.classes import CLASS_NAMES
+from dataset.presets import preset_recipes
 from dataset.scenes.images import read_labels, read_rgb, write_labels, write_rgb
 from dataset.scenes.scene import read_scene
 from segment.augment import AugmentConfig
@@ -17,7 +18,12 @@ from segment.network import UNetConfig
 from segment.scene_masks import RECORD_KEY, predicted_scene
 from segment.segmenter import Segmenter, network_segmenter
 from segment.train import TrainConfig, main, train_segmenter
-from segment.training_data import load_training_scenes, split_by_building
+from segment.training_data import (
+    EVALUATED_PRESETS,
+    TRAINING_PRESET,
+    load_training_scenes,
+    split_by_building,
+)
 
 FEW_STEPS = TrainConfig(steps=3, batch=2, threads=1, val_every=0, validate_every=2,
                         network=UNetConfig(base_channels=4, levels=3),
@@ -46,6 +52,27 @@ def test_a_few_steps_write_weights_with_their_record(trained, clean_scene):
 def test_training_refuses_evaluated_buildings(tiny_benchmark):
     with pytest.raises(ValueError, match="'tiny' preset, which is evaluated"):
         load_training_scenes([tiny_benchmark])
+
+
+@pytest.mark.parametrize("preset", ["paper", "heldout"])
+def test_training_refuses_every_evaluated_preset(clean_scene, tmp_path, preset):
+    scene = tmp_path / clean_scene.name
+    shutil.copytree(clean_scene, scene)
+    tf = json.loads((scene / "transforms.json").read_text())
+    tf.setdefault("generator", {}).setdefault("provenance", {}).setdefault("inputs", {})[
+        "preset"] = preset
+    (scene / "transforms.json").write_text(json.dumps(tf))
+    with pytest.raises(ValueError, match=f"'{preset}' preset, which is evaluated"):
+        load_training_scenes([tmp_path])
+
+
+def test_training_buildings_share_no_seed_with_an_evaluated_preset():
+    assert {"paper", "tiny", "heldout"} <= set(EVALUATED_PRESETS)
+    assert TRAINING_PRESET not in EVALUATED_PRESETS
+    train = {r.seed for r in preset_recipes(TRAINING_PRESET)}
+    assert len(train) == 48
+    for preset in EVALUATED_PRESETS:
+        assert not train & {r.seed for r in preset_recipes(preset)}, preset
 
 
 def test_the_split_keeps_a_building_on_one_side(clean_scene):
