@@ -339,7 +339,7 @@ def compare_on_masks(request: CompareRequest, command: str, *, allow_run: bool,
     start = time.perf_counter()
     assert request.masks is not None
     segmenter = masks_segmenter(request.masks)
-    _prepare(request, comparisons=2)
+    _prepare(request, comparisons=2, inputs="exact and predicted masks")
     table, run = compare_on_predicted_masks(
         segmenter, request.data, request.results, request.out,
         lambda results: _specs(request, results), compare, command=command,
@@ -380,13 +380,15 @@ def _specs(request: CompareRequest, results: Path) -> list[MethodSpec]:
                         seeds=request.seeds)
 
 
-def _prepare(request: CompareRequest, comparisons: int = 1) -> None:
-    """For the built-in default run: say what it does, then generate its benchmark if absent."""
+def _prepare(request: CompareRequest, comparisons: int = 1,
+             inputs: str = "clean and degraded inputs") -> None:
+    """For the built-in default run: say what it does (``comparisons`` on ``inputs``), then
+    generate its benchmark if absent."""
     if request.default is None:
         return
     steps = {s.name: n for s in _specs(request, request.results)
              if (n := recorded_steps(s.config)) is not None}
-    print(request.default.announce(request.methods, steps, comparisons), flush=True)
+    print(request.default.announce(request.methods, steps, comparisons, inputs), flush=True)
     ensure_benchmark(request.default)
 
 
