@@ -10,9 +10,11 @@ Areas are regions in the facade's plane (u along the wall to the right seen from
 v = z above the ground), built with shapely:
 
 - an opening (a ``Window`` or ``Door`` with all its polygons: glass, frame, mullions, sill)
-  takes the union of its polygons projected onto the plane, so a window modelled with a
-  hundred polygons counts once; frames and sills count as window, its reveal sides
-  (perpendicular to the wall) project to nothing;
+  takes the union of its polygons projected onto the plane, less what a wall polygon in
+  front of them hides (a frame modelled into the wall behind the reveal), so a window
+  modelled with a hundred polygons counts once, as seen head-on; frames and sills count as
+  window, its reveal sides (perpendicular to the wall) project to nothing; where openings
+  overlap head-on, the one in front (mean depth along the normal) takes the overlap;
 - a hole in a wall polygon that the openings cover by at least ``min_hole_cover`` is the
   opening's rough opening: the uncovered rim (the gap modellers leave between hole and
   frame) counts as that opening too and gets a filler surface in the wall's plane, so the
@@ -35,6 +37,8 @@ from dataset.importers.citygml_polygons import MIN_AREA_M2, PolygonTriangles
 from dataset.importers.facade_grouping import group_facades
 
 _UP = np.array([0.0, 0.0, 1.0])
+IN_FRONT_M = 0.001
+"""A wall polygon this far (1 mm) or more in front of an opening's triangle hides it."""
 
 
 @dataclass(frozen=True)
@@ -184,6 +188,31 @@ def _union_uv(tri_m: np.ndarray, tangent: np.ndarray) -> Polygon | MultiPolygon:
     return shapely.union_all(shapely.polygons(uv[keep]))
 
 
+def _visible_uv(tri_m: np.ndarray, walls: list[PolygonTriangles], wall_polys: list,
+                n: np.ndarray, t: np.ndarray):
+    """Projection of an opening's (T, 3, 3) triangles without what the facade's walls hide:
+    a wall polygon more than :data:`IN_FRONT_M` in front of a triangle (a frame modelled
+    into the reveal, behind the wall) covers it."""
+    centre = tri_m.mean(axis=1)
+    if not walls:
+        return _union_uv(tri_m, t)
+    origins = np.stack([w.origin_m for w in walls])
+    normals = np.stack([w.normal for w in walls])
+    # Distance along n from each triangle's centre to each wall's plane: > 0 means in front.
+    ahead = (np.einsum("wk,wk->w", origins, normals)[None, :] - centre @ normals.T)
+    ahead = ahead / np.where(np.abs(normals @ n) > 1e-6, normals @ n, np.inf)[None, :]
+    front = ahead > IN_FRONT_M
+    parts = []
+    for mask in np.unique(front, axis=0):
+        rows = np.all(front == mask, axis=1)
+        region = _union_uv(tri_m[rows], t)
+        if mask.any():
+            region = region.difference(shapely.union_all([wall_polys[j]
+                                                          for j in np.flatnonzero(mask)]))
+        parts.append(region)
+    return shapely.union_all(parts)
+
+
 def _polygon_uv(surface: Surface, tangent: np.ndarray):
     rings = [np.column_stack([r @ tangent, r[:, 2]]) for r in surface.rings_m]
     poly = Polygon(rings[0], rings[1:])
@@ -197,12 +226,21 @@ def _regions(surfaces, group, walls, openings, config) -> FacadeRegions:
     wall_union = shapely.union_all(wall_polys)
     regions: dict[str, list] = {"window": [], "door": []}
     opening_uv = {}
+    depth = {}
     for o in openings:
         idx = [i for i, s in enumerate(surfaces) if s.owner_id == o and s.kind in
                ("window", "door")]
         tri = np.concatenate([surfaces[i].tri.vertices_m[surfaces[i].tri.faces] for i in idx])
-        opening_uv[o] = (surfaces[idx[0]].kind, _union_uv(tri, t))
-        regions[surfaces[idx[0]].kind].append(opening_uv[o][1])
+        opening_uv[o] = (surfaces[idx[0]].kind,
+                         _visible_uv(tri, [surfaces[i].tri for i in walls], wall_polys, n, t))
+        area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+        depth[o] = float((tri.mean(axis=1) @ n * area).sum() / max(area.sum(), 1e-300))
+    # Where openings overlap head-on (a door in front of shop glazing), the front one shows.
+    taken = Polygon()
+    for o in sorted(opening_uv, key=lambda o: (-depth[o], o)):
+        kind, region = opening_uv[o]
+        regions[kind].append(region.difference(taken))
+        taken = taken.union(region)
     covered = shapely.union_all([r for _, r in opening_uv.values()])
     fill_tris, fill_kind = [], []
     for i, poly in zip(walls, wall_polys):
@@ -213,12 +251,12 @@ def _regions(surfaces, group, walls, openings, config) -> FacadeRegions:
                 continue
             kind = max(opening_uv.values(), key=lambda kr: kr[1].intersection(hole).area)[0]
             rim = hole.difference(covered)
-            regions[kind].append(hole)
+            regions[kind].append(rim)
             tris = _lift(_triangulate_uv(rim), surfaces[i].tri, n, t)
             fill_tris.append(tris)
             fill_kind += [kind] * len(tris)
     window = shapely.union_all(regions["window"])
-    door = shapely.union_all(regions["door"]).difference(window)
+    door = shapely.union_all(regions["door"]).difference(window)  # a hole's rim: window wins
     gross = shapely.union_all([wall_union, window, door])
     u0, _, u1, v1 = gross.bounds
     above = box(u0 - 1.0, 0.0, u1 + 1.0, max(v1, 0.0) + 1.0)

@@ -49,6 +49,7 @@ from dataset.importers.citygml_read import (
     CityBuilding,
     CityGmlError,
     CityModel,
+    citygml_stem,
     read_citygml,
 )
 
@@ -107,7 +108,7 @@ def benchmark_buildings(model: CityModel) -> list[CityBuilding]:
     out = []
     for b in kept:
         parts = joined.get(b.gml_id, [])
-        name = _SAFE.sub("_", model.path.stem if len(kept) == 1 else b.gml_id)
+        name = _SAFE.sub("_", citygml_stem(model.path) if len(kept) == 1 else b.gml_id)
         out.append(replace(
             b, gml_id=name if name[:1].isalnum() else f"b{name}",
             polygons=b.polygons + tuple(p for c in parts for p in c.polygons),

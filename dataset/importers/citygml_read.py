@@ -16,6 +16,9 @@ Errors name the file and the element's ``gml:id`` (:class:`CityGmlError`).
 
 from __future__ import annotations
 
+import bz2
+import gzip
+import lzma
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,6 +56,7 @@ CITYGML_VERSIONS = {"http://www.opengis.net/citygml/2.0": "2.0",
 GEOGRAPHIC_EPSG = frozenset({4326, 4258, 4269, 4937, 4979, 4978, 4289, 4167})
 """EPSG codes in degrees (or geocentric): refused, the importer needs metres."""
 _ADV_CRS = {"ETRS89_UTM32": 25832, "ETRS89_UTM33": 25833}  # German AdV names (urn:adv:crs:...)
+_OPENERS = {".gz": gzip.open, ".xz": lzma.open, ".bz2": bz2.open}
 _XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 _EPSG_PATTERNS = (re.compile(r"EPSG:{1,2}(\d+)", re.I), re.compile(r"/EPSG/\d+/(\d+)", re.I))
 
@@ -118,16 +122,20 @@ def read_citygml(path: str | Path) -> CityModel:
         CityGML ``CityModel``, no building, a missing, unknown or geographic CRS, a ring with
         fewer than three points or a coordinate count not a multiple of three, an xlink to
         nothing. A ring of three or more points of which fewer than three are distinct has no
-        area: it is dropped (a hole) or drops its polygon, and listed in the building's ``warnings``.
+        area: it is dropped (a hole) or drops its polygon, and listed in the building's
+        ``warnings``. Files compressed with gzip, xz or bzip2 (``.gz``, ``.xz``, ``.bz2``)
+        are read as they are.
     """
     from lxml import etree
 
     path = Path(path)
     if not path.is_file():
         raise CityGmlError(f"CityGML file {path} does not exist")
+    opener = _OPENERS.get(path.suffix.lower(), open)
     try:
-        tree = etree.parse(str(path), etree.XMLParser(huge_tree=True, resolve_entities=False))
-    except etree.XMLSyntaxError as exc:
+        with opener(path, "rb") as fh:
+            tree = etree.parse(fh, etree.XMLParser(huge_tree=True, resolve_entities=False))
+    except (etree.XMLSyntaxError, EOFError, OSError, lzma.LZMAError) as exc:
         raise CityGmlError(
             f"{path} is not well-formed XML ({exc}); a truncated download or copy ends like "
             "this: fetch the file again") from exc
@@ -155,6 +163,41 @@ def read_citygml(path: str | Path) -> CityModel:
     if not buildings:
         raise CityGmlError(f"{path} holds no Building or BuildingPart element")
     return CityModel(path, version, _crs(path, root, buildings[0].gml_id), tuple(buildings))
+
+
+def citygml_files(path: str | Path) -> list[Path]:
+    """The CityGML files ``path`` names: itself, or every ``.gml``/``.xml`` file below a folder
+    (also compressed: ``.gz``, ``.xz``, ``.bz2``), sorted.
+
+    Raises
+    ------
+    CityGmlError
+        ``path`` does not exist or the folder holds no such file.
+    """
+    path = Path(path)
+    if path.is_file():
+        return [path]
+    if not path.is_dir():
+        raise CityGmlError(f"{path} does not exist; give a CityGML file or a folder of them")
+    files = sorted(p for p in path.rglob("*") if p.is_file() and _stem_suffix(p)[1])
+    if not files:
+        raise CityGmlError(f"{path} holds no .gml or .xml file (plain, .gz, .xz or .bz2)")
+    return files
+
+
+def citygml_stem(path: str | Path) -> str:
+    """A CityGML file's name without its suffixes: ``4018259.xml.xz`` -> ``4018259``."""
+    return _stem_suffix(Path(path))[0]
+
+
+def _stem_suffix(path: Path) -> tuple[str, str]:
+    name = path.name
+    low = name.lower()
+    for comp in ("", *_OPENERS):
+        for ext in (".gml", ".xml"):
+            if low.endswith(ext + comp):
+                return name[: len(name) - len(ext + comp)], ext + comp
+    return path.stem, ""
 
 
 def _gml_id_attr(el) -> str:
