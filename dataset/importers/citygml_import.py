@@ -67,6 +67,10 @@ LABEL_OF_KIND: dict[str, SemanticClass | None] = {
     "interior": None,  # LoD4 rooms: never seen from outside
 }
 """Class of each surface kind in the mesh; None: left out of the mesh."""
+WALL_SECTION_M = 0.3
+"""Without a ground surface the footprint is what the walls enclose this high above the
+lowest wall point: above a street's slope (up to ~0.2 m across a house here), below most
+sills (higher, the gaps modellers leave around windows break the outline)."""
 _ENCLOSING = ("wall", "roof", "ground", "closure", "outer_floor", "outer_ceiling")
 
 
@@ -154,7 +158,7 @@ def building_from_citygml(model: CityModel, building: CityBuilding, *,
     truths = tuple(_facade_truth(facade_id[k], facades[k]) for k in covered)
     window, wall, door = (sum(getattr(f, a) for f in truths)
                           for a in ("window_area_m2", "wall_area_m2", "door_area_m2"))
-    footprint = _footprint(surfaces, mesh, warnings)
+    footprint = _footprint(surfaces, mesh, warnings, where)
     height = float(mesh.vertices_m[:, 2].max())
     truth = BuildingTruth(
         id=building.gml_id, type="imported",
@@ -295,15 +299,38 @@ def _fill_area(f: FacadeRegions) -> float:
                                       axis=1).sum()) if len(t) else 0.0
 
 
-def _footprint(surfaces: list[Surface], mesh: LabelledMesh, warnings: Counter):
-    """Union of the ground surfaces seen from above; without one, the walls' section 5 cm
-    above the ground (:func:`dataset.rendering.section.cross_section_footprint`)."""
+def _footprint(surfaces: list[Surface], mesh: LabelledMesh, warnings: Counter, where: str):
+    """Union of the ground surfaces seen from above; without one, what the walls enclose
+    :data:`WALL_SECTION_M` above the lowest wall point (:func:`_walls_outline`)."""
     ground = [Polygon(r[0][:, :2], [h[:, :2] for h in r[1:]])
               for r in (s.rings_m for s in surfaces if s.kind == "ground")]
     if ground:
         return shapely.union_all([g if g.is_valid else shapely.make_valid(g) for g in ground])
-    from dataset.rendering.raycast import Raycaster
-    from dataset.rendering.section import cross_section_footprint
+    warnings[f"footprint from the walls {WALL_SECTION_M} m above the ground (no "
+             "GroundSurface)"] += 1
+    outline = _walls_outline(mesh, WALL_SECTION_M)
+    if outline.is_empty:
+        raise CityGmlError(f"{where}: no GroundSurface, and the walls {WALL_SECTION_M} m above "
+                           "the ground enclose nothing; add the GroundSurface")
+    return outline
 
-    warnings["footprint from the walls 5 cm above the ground (no GroundSurface)"] += 1
-    return cross_section_footprint(Raycaster(mesh), 0.05)
+
+def _walls_outline(mesh: LabelledMesh, z_m: float):
+    """The region the wall, window and door faces enclose at height ``z_m``: their section's
+    segments polygonised, every face of that arrangement kept, holes filled. Boundary
+    surfaces are open (no floor), so the mesh's inside rule cannot decide here."""
+    import trimesh
+    from shapely.geometry import MultiLineString
+    from shapely.ops import polygonize
+
+    facing = np.isin(mesh.face_label, [int(SemanticClass.WALL), int(SemanticClass.WINDOW),
+                                       int(SemanticClass.DOOR)])
+    tm = trimesh.Trimesh(mesh.vertices_m, mesh.faces[facing], process=False)
+    segments = trimesh.intersections.mesh_plane(tm, [0.0, 0.0, 1.0], [0.0, 0.0, z_m])
+    if len(segments) == 0:
+        return Polygon()
+    lines = shapely.set_precision(MultiLineString([s[:, :2] for s in segments]), 1e-6)
+    regions = shapely.union_all([p for p in polygonize(shapely.union_all(lines))
+                                 if p.area > 0])
+    parts = getattr(regions, "geoms", [regions])
+    return shapely.union_all([Polygon(p.exterior) for p in parts if not p.is_empty])
