@@ -132,7 +132,7 @@ def building_from_citygml(model: CityModel, building: CityBuilding, *,
         The building has no (non-degenerate) ``WallSurface`` polygon.
     """
     config = CityGmlConfig() if config is None else config
-    where = f"{model.path}: building {building.gml_id}"
+    where = f"{model.path}: building {building.attributes.get('gml:id', building.gml_id)}"
     warnings: Counter[str] = Counter(_warning_kind(w) for w in building.warnings)
     surfaces = []
     for p in building.polygons:
