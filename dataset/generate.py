@@ -185,7 +185,9 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
             "examples: python -m dataset.generate --preset tiny --out data/tiny | "
             "python -m dataset.generate --preset paper --out data/paper --workers 2 | "
             "python -m dataset.generate --mesh house.ply --out data/mine | "
-            "python -m dataset.generate --ifc house.ifc --out data/mine. "
+            "python -m dataset.generate --ifc house.ifc --out data/mine | "
+            "python -m dataset.generate --citygml city.gml --out data/city | "
+            "python -m dataset.generate --preset lod3 --out data/lod3. "
             "Layout and options: docs/rendering.md."
         ),
     )
@@ -196,6 +198,10 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
                           "class-named parts), metres, z up; see docs/importing.md")
     src.add_argument("--ifc", type=Path, metavar="FILE",
                      help="an IFC model (ArchiCAD, Revit, ... export); see docs/importing.md")
+    src.add_argument("--citygml", type=Path, metavar="FILE_OR_DIR",
+                     help="CityGML 2.0/3.0 LoD3 buildings: a .gml/.xml file (also .gz/.xz) or "
+                          "a folder of them; one scene per Building/BuildingPart with a "
+                          "window or door; see docs/importing.md (CityGML)")
     p.add_argument("--ifc-classes", type=Path, metavar="JSON",
                    help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
                         '{"IfcCovering": "wall", "IfcRailing": "skip"}')
@@ -253,6 +259,8 @@ def main(argv: list[str] | None = None) -> int:
             scenes = generate_preset(args.preset, args.out, config, workers=args.workers,
                                      seed=args.seed, overwrite=args.overwrite,
                                      progress=not args.quiet, ray=ray)
+        elif args.citygml is not None:
+            scenes = _generate_citygml(args, config)
         else:
             scenes = [_generate_mesh(args, config)]
         for scene in scenes:
@@ -278,6 +286,41 @@ def _check_resources(args: argparse.Namespace, config: GenerateConfig) -> None:
     check_generate_resources(config.resolution, config.supersampling,
                              config.views + FACADE_VIEWS_PER_BUILDING, scenes,
                              min(args.workers, scenes) if scenes > 1 else args.workers, args.out)
+
+
+def _generate_citygml(args: argparse.Namespace, config: GenerateConfig) -> list[Path]:
+    """Every building of ``--citygml`` that has a covered facade, one scene each. All files
+    are read before anything is written, so bad input leaves ``--out`` as it was."""
+    from dataset.core.provenance import file_fingerprint
+    from dataset.importers.citygml_import import import_citygml
+    from dataset.importers.citygml_read import citygml_files
+
+    files = citygml_files(args.citygml)
+    jobs = []
+    for path in tqdm(files, desc="CityGML", unit="file", disable=args.quiet or len(files) < 2):
+        for building in import_citygml(path):
+            if building.truth.facades:
+                jobs.append((building, {"citygml": file_fingerprint(path),
+                                        "building": building.truth.id}))
+            else:
+                tqdm.write(f"{path}: building {building.truth.id} has no window or door "
+                           "modelled (no covered facade): skipped")
+    if not jobs:
+        raise ValueError(f"{args.citygml}: no building with a window or door modelled; the "
+                         "benchmark needs LoD3 openings (WallSurface with Window/Door)")
+    check_writable(args.out)
+    scenes = []
+    for building, inputs in tqdm(jobs, desc="scenes", unit="building",
+                                 disable=args.quiet or len(jobs) < 2):
+        name = building.truth.id
+        _remove_stale_partials(args.out, name)
+        changes = scene_changes(args.out / name, config, args.seed, inputs)
+        if changes:
+            _check_replaceable(args.out / name, changes, args.overwrite, tqdm.write)
+            generate_scene(building, args.out, config, seed=args.seed,
+                           progress=not args.quiet, workers=args.workers, inputs=inputs)
+        scenes.append(args.out / name)
+    return scenes
 
 
 def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:

@@ -6,7 +6,10 @@ a model; :func:`build_building` turns it into mesh + truth deterministically
 
 - ``paper``: 12 skyscrapers, 12 L-shaped buildings and the four realistic models;
 - ``tiny``: one small building per family (a 9-storey skyscraper, a 4-storey L-shape
-  and the realistic house), cheap to render, for tests and defaults.
+  and the realistic house), cheap to render, for tests and defaults;
+- ``lod3``: 49 real buildings, the Ingolstadt LoD3 CityGML models that have windows
+  (family ``citygml``; files in ``dataset/examples/lod3_ingolstadt``, CC BY-SA 4.0,
+  :mod:`dataset.importers.citygml_preset`).
 
 Run ``python -m dataset.presets`` to print the ranges a preset spans.
 """
@@ -28,9 +31,9 @@ from dataset.families.realistic import make_realistic, sample_realistic_params
 from dataset.families.realistic_params import REALISTIC_MODELS
 from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_params
 
-Family = Literal["skyscraper", "l_shaped", "realistic"]
-FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic")
-PRESETS = ("paper", "tiny")
+Family = Literal["skyscraper", "l_shaped", "realistic", "citygml"]
+FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "citygml")
+PRESETS = ("paper", "tiny", "lod3")
 _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 # Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
@@ -45,11 +48,13 @@ _PAPER_SEEDS = {
     "l_shaped": (2000, 2001, 2002, 2003, 2004, 2005, 2006, 2040, 2046, 2060, 2122, 2143),
 }
 _REALISTIC_SEED = 3000
+_LOD3_SEED = 4000  # + the building's index: cameras and looks of the lod3 scenes
 
 
 @dataclass(frozen=True)
 class BuildingRecipe:
-    """How to build one building: ``id`` (file-system safe), family, seed, realistic model."""
+    """How to build one building: ``id`` (file-system safe), family, seed, and ``model``: the
+    realistic model's name, or a ``citygml`` building's file in the lod3 data folder."""
 
     id: str
     family: Family
@@ -69,8 +74,11 @@ class BuildingRecipe:
                 f"a realistic recipe needs model one of {', '.join(REALISTIC_MODELS)}, "
                 f"got {self.model!r}"
             )
-        if self.family != "realistic" and self.model is not None:
-            raise ValueError(f"only realistic recipes take a model, got model={self.model!r}")
+        if self.family == "citygml" and not self.model:
+            raise ValueError("a citygml recipe needs model = its file in the lod3 data folder")
+        if self.family not in ("realistic", "citygml") and self.model is not None:
+            raise ValueError(f"only realistic and citygml recipes take a model, got "
+                             f"model={self.model!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int | np.integer) or (
             self.seed < 0
         ):
@@ -97,6 +105,11 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
             for k, m in enumerate(REALISTIC_MODELS)
         ]
         return tuple(recipes)
+    if name == "lod3":
+        from dataset.importers.citygml_preset import lod3_entries
+
+        return tuple(BuildingRecipe(e.id, "citygml", _LOD3_SEED + k, e.file)
+                     for k, e in enumerate(lod3_entries()))
     raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
 
 
@@ -104,6 +117,10 @@ def build_building(recipe: BuildingRecipe) -> Building:
     """Mesh and exact truth of ``recipe`` (same recipe -> identical mesh and truth)."""
     if not isinstance(recipe, BuildingRecipe):
         raise ValueError(f"build_building needs a BuildingRecipe, got {type(recipe).__name__}")
+    if recipe.family == "citygml":
+        from dataset.importers.citygml_preset import build_lod3_building
+
+        return build_lod3_building(recipe.id, recipe.model)
     rng = np.random.default_rng(recipe.seed)
     if recipe.family == "skyscraper":
         params = sample_skyscraper_params(rng)
