@@ -145,8 +145,8 @@ def read_citygml(path: str | Path) -> CityModel:
         raise CityGmlError(
             f"{path} is not CityGML 2.0 or 3.0: its root element is {root.tag!r}, expected "
             "CityModel in the namespace http://www.opengis.net/citygml/2.0 or /3.0")
-    by_id = {el.get(_gml_id_attr(el)): el for el in root.iter("{*}Polygon")
-             if el.get(_gml_id_attr(el)) is not None}
+    by_id = {i: el for el in root.iter() if isinstance(el.tag, str)
+             for i in [_gml_id(el)] if i is not None}
     buildings = []
     for el in root.iter(*(f"{{*}}{t}" for t in BUILDING_TAGS)):
         gml_id = _gml_id(el) or f"{etree.QName(el).localname}#{len(buildings) + 1}"
@@ -200,13 +200,6 @@ def _stem_suffix(path: Path) -> tuple[str, str]:
     return path.stem, ""
 
 
-def _gml_id_attr(el) -> str:
-    for key in el.attrib:
-        if key.endswith("}id") and "gml" in key:
-            return key
-    return "{http://www.opengis.net/gml}id"
-
-
 def _gml_id(el) -> str | None:
     for key, value in el.attrib.items():
         if key.endswith("}id") and "gml" in key:
@@ -237,26 +230,16 @@ def _semantic_owner(el, building, plain: SurfaceKind | None = None):
 def _building_polygons(path: Path, building, building_id: str, by_id: dict,
                        warnings: list[str], plain: SurfaceKind | None = None):
     seen: set[str] = set()
-    sources = [(p, p) for p in building.iter("{*}Polygon")]
-    sources += [(m, None) for m in building.iter("{*}surfaceMember", "{*}baseSurface")
-                if m.get(_XLINK_HREF)]
-    for anchor, polygon in sources:
+    for anchor, polygon, reverse in _polygon_sources(path, building, building_id, by_id):
         owner = _semantic_owner(anchor, building, plain)
         if owner is None:
             continue
         owner_el, kind = owner
-        if polygon is None:
-            ref = anchor.get(_XLINK_HREF).lstrip("#")
-            polygon = by_id.get(ref)
-            if polygon is None:
-                raise CityGmlError(f"{path}: building {building_id}: xlink:href '#{ref}' "
-                                   "points to no gml:Polygon in this file")
         owner_id = _gml_id(owner_el) or building_id
         polygon_id = _gml_id(polygon) or f"{owner_id}#{len(seen) + 1}"
         if polygon_id in seen:
             continue
         seen.add(polygon_id)
-        reverse = _reversed(polygon)
         rings = [_ring_points(path, r, polygon_id) for r in _rings(polygon)]
         if not rings:
             raise CityGmlError(f"{path}: polygon {polygon_id} has no exterior ring")
@@ -269,6 +252,31 @@ def _building_polygons(path: Path, building, building_id: str, by_id: dict,
                             "(no area), hole dropped")
         rings = tuple(r[::-1] if reverse else r for r in rings if r is not None)
         yield CityPolygon(polygon_id, kind, owner_id, rings)
+
+
+def _polygon_sources(path: Path, building, building_id: str, by_id: dict):
+    """(anchor, gml:Polygon, reversed) for every polygon under ``building``, inline or through
+    an ``xlink:href`` (to a polygon or to a surface holding polygons); the anchor is where
+    the polygon is used, which decides its semantics."""
+    for polygon in building.iter("{*}Polygon"):
+        yield polygon, polygon, _reversed(polygon)
+    for anchor in building.iter("{*}surfaceMember", "{*}baseSurface"):
+        ref = (anchor.get(_XLINK_HREF) or "").lstrip("#")
+        if not ref:
+            continue
+        target = by_id.get(ref)
+        if target is None:
+            raise CityGmlError(f"{path}: building {building_id}: xlink:href '#{ref}' "
+                               "points to no element with that gml:id in this file")
+        holder = anchor.getparent()
+        reverse = (_local(anchor) == "baseSurface" and holder is not None
+                   and _local(holder) == "OrientableSurface"
+                   and holder.get("orientation") == "-")
+        if _local(target) == "Polygon":  # its own place's orientation is not this use's
+            yield anchor, target, reverse
+            continue
+        for polygon in target.iter("{*}Polygon"):
+            yield anchor, polygon, reverse != _reversed(polygon)
 
 
 def _reversed(polygon) -> bool:
