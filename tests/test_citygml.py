@@ -205,3 +205,16 @@ def test_classes_and_what_is_left_out(imported):
     facing = np.einsum("ij,ij->i", mesh.face_normals()[wall][:, :2], out)
     assert (mesh.face_areas_m2()[wall] * np.sign(facing)).sum() > 0.8 * mesh.face_areas_m2()[
         wall].sum()
+
+
+@pytest.mark.parametrize(("field", "value", "message"), [
+    ("max_tilt_deg", 95.0, "max_tilt_deg must be in"),
+    ("gap_tolerance_m", -1.0, "gap_tolerance_m must be >= 0"),
+    ("min_hole_cover", 0.0, "min_hole_cover must be in"),
+    ("max_opening_depth_m", 0.0, "max_opening_depth_m must be > 0"),
+])
+def test_config_rejects_bad_tolerances(field, value, message):
+    from dataset.importers.citygml_config import CityGmlConfig
+
+    with pytest.raises(ValueError, match=message):
+        CityGmlConfig(**{field: value})

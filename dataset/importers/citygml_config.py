@@ -8,6 +8,8 @@ from dataclasses import dataclass
 from dataset.importers.import_config import ImportConfig
 
 _MESH = ImportConfig()
+_SHARED = ("max_tilt_deg", "angle_tolerance_deg", "offset_tolerance_m", "gap_tolerance_m",
+           "min_facade_width_m", "floor_height_m")
 
 
 @dataclass(frozen=True)
@@ -43,13 +45,9 @@ class CityGmlConfig:
     """Storey height: floors = round(height / floor_height_m), at least 1."""
 
     def __post_init__(self) -> None:
-        for name in ("max_tilt_deg", "angle_tolerance_deg"):
-            if not 0 < getattr(self, name) < 90:
-                raise ValueError(f"{name} must be in (0, 90) degrees, got {getattr(self, name)}")
-        for name in ("offset_tolerance_m", "gap_tolerance_m", "min_facade_width_m"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"{name} must be >= 0 m, got {getattr(self, name)}")
-        if self.max_opening_depth_m <= 0 or self.floor_height_m <= 0:
-            raise ValueError("max_opening_depth_m and floor_height_m must be > 0 m")
+        # The shared tolerances are checked where they are defined.
+        ImportConfig(**{name: getattr(self, name) for name in _SHARED})
+        if self.max_opening_depth_m <= 0:
+            raise ValueError(f"max_opening_depth_m must be > 0 m, got {self.max_opening_depth_m}")
         if not 0 < self.min_hole_cover <= 1:
             raise ValueError(f"min_hole_cover must be in (0, 1], got {self.min_hole_cover}")
