@@ -49,8 +49,8 @@ def main() -> int:
         "covered facade",
         "",
         "| building | facades | window m² | bare window | bare gross | seen window | seen gross"
-        " | import s |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|",
+        " | hidden by (m²) | installation polygons | import s |",
+        "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|",
     ]
     lines += [_line(r) for r in rows]
     off = [r for r in rows if max(abs(r["bare_window"]), abs(r["bare_gross"])) > AGREE]
@@ -74,8 +74,15 @@ def _row(building, checks, t_import: float) -> dict:
         return sum(sum(getattr(c, attr).values()) if key == "gross" else getattr(c, attr)[key]
                    for c in checks)
 
+    hidden: dict[str, float] = {}
+    for c in checks:
+        for k, v in c.hidden_by_m2.items():
+            hidden[k] = hidden.get(k, 0.0) + v
     row = {"id": building.truth.id, "facades": len(checks),
-           "window": total("truth_m2", "window"), "t": t_import}
+           "window": total("truth_m2", "window"), "t": t_import,
+           "hidden": ", ".join(f"{k} {v:.1f}" for k, v in sorted(hidden.items(),
+                                                                 key=lambda kv: -kv[1])),
+           "installations": building.truth.extra["counts"].get("installation", 0)}
     for key in ("window", "gross"):
         truth = total("truth_m2", key)
         for attr, name in (("bare_m2", "bare"), ("rendered_m2", "seen")):
@@ -86,7 +93,7 @@ def _row(building, checks, t_import: float) -> dict:
 def _line(r: dict) -> str:
     return (f"| {r['id']} | {r['facades']} | {r['window']:.1f} | {r['bare_window']:+.2%} | "
             f"{r['bare_gross']:+.2%} | {r['seen_window']:+.2%} | {r['seen_gross']:+.2%} | "
-            f"{r['t']:.1f} |")
+            f"{r['hidden']} | {r['installations']} | {r['t']:.1f} |")
 
 
 if __name__ == "__main__":

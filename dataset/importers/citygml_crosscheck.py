@@ -43,13 +43,17 @@ class FacadeCheck:
     """One facade's areas (m²) as the truth gives them and as rendered labels give them.
 
     ``truth_m2``, ``bare_m2`` (facade surfaces alone), ``rendered_m2`` (whole mesh): class
-    name (``window``, ``wall``, ``door``) -> area.
+    name (``window``, ``wall``, ``door``) -> area. ``hidden_by_m2``: what the whole mesh
+    shows where the bare render shows the facade, by class (``other``: installations,
+    balconies, ground and outer floors/ceilings; ``wall``: another facade's or an
+    uncovered wall in front).
     """
 
     facade_id: int
     truth_m2: dict[str, float]
     bare_m2: dict[str, float]
     rendered_m2: dict[str, float]
+    hidden_by_m2: dict[str, float]
 
     def relative_error(self, name: str, *, bare: bool = True) -> float:
         """(rendered - truth) / truth of ``window``, ``door``, ``wall`` or ``gross`` (their
@@ -80,24 +84,27 @@ def check_facades(building: Building, *, pixel_m: float = PIXEL_M) -> list[Facad
         bare = Raycaster(LabelledMesh(mesh.vertices_m, mesh.faces[keep], mesh.face_label[keep],
                                       mesh.face_facade[keep]))
         outline = np.asarray(building.truth.facade_outlines_m[facade.id][0])
-        normal = np.asarray(facade.normal)
         truth = {"window": facade.window_area_m2, "wall": facade.wall_area_m2,
                  "door": facade.door_area_m2}
-        out.append(FacadeCheck(
-            facade.id, truth,
-            _facade_areas_m2(bare, outline, normal, facade.id, pixel_m),
-            _facade_areas_m2(whole, outline, normal, facade.id, pixel_m)))
+        bare_m2, seen_m2, hidden_m2 = _facade_areas_m2(
+            bare, whole, outline, np.asarray(facade.normal), facade.id, pixel_m)
+        out.append(FacadeCheck(facade.id, truth, bare_m2, seen_m2, hidden_m2))
     return out
 
 
 _CLASSES = {"window": SemanticClass.WINDOW, "wall": SemanticClass.WALL,
             "door": SemanticClass.DOOR}
+_HIDERS = {"other": SemanticClass.OTHER, "roof": SemanticClass.ROOF,
+           "wall": SemanticClass.WALL, "window": SemanticClass.WINDOW,
+           "door": SemanticClass.DOOR}
 
 
-def _facade_areas_m2(raycaster: Raycaster, outline_m: np.ndarray, normal: np.ndarray,
-                     facade_id: int, pixel_m: float) -> dict[str, float]:
-    """Back-projected area per class of the pixels of facade ``facade_id`` over its outline
-    rectangle (+ 1 pixel)."""
+def _facade_areas_m2(bare: Raycaster, whole: Raycaster, outline_m: np.ndarray,
+                     normal: np.ndarray, facade_id: int, pixel_m: float
+                     ) -> tuple[dict[str, float], dict[str, float], dict[str, float]]:
+    """Back-projected areas over the facade's outline rectangle (+ 1 pixel): per class of the
+    facade's pixels in the bare and the whole render, and per class of what the whole mesh
+    shows where the bare render shows the facade (what hides it)."""
     tangent = np.cross(_UP, normal)
     u = outline_m @ tangent
     v = outline_m[:, 2]
@@ -109,15 +116,24 @@ def _facade_areas_m2(raycaster: Raycaster, outline_m: np.ndarray, normal: np.nda
     eye = centre[0] * tangent + centre[1] * _UP + (plane + CAMERA_DISTANCE_M) * normal
     pose = np.eye(4)
     pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = tangent, _UP, normal, eye
-    counts = dict.fromkeys(_CLASSES, 0)
+    bare_n, seen_n, hidden_n = (dict.fromkeys(_CLASSES, 0), dict.fromkeys(_CLASSES, 0),
+                                dict.fromkeys(_HIDERS, 0))
     for x0 in range(0, width, TILE_PX):
         for y0 in range(0, height, TILE_PX):
             w, h = min(TILE_PX, width - x0), min(TILE_PX, height - y0)
             # Tile's left edge is u0 + x0 * pixel; the principal point is the camera centre.
             k = Intrinsics(focal, focal, (centre[0] - (u0 + x0 * pixel_m)) / pixel_m,
                            ((v1 - y0 * pixel_m) - centre[1]) / pixel_m, w, h)
-            gt = render_ground_truth(raycaster, k, pose)
-            mine = gt.facade_ids == facade_id
+            mine_bare = render_ground_truth(bare, k, pose)
+            seen = render_ground_truth(whole, k, pose)
+            on_bare = mine_bare.facade_ids == facade_id
+            on_seen = seen.facade_ids == facade_id
             for name, c in _CLASSES.items():
-                counts[name] += int(np.count_nonzero(mine & (gt.labels == c)))
-    return {name: n * pixel_m * pixel_m for name, n in counts.items()}
+                bare_n[name] += int(np.count_nonzero(on_bare & (mine_bare.labels == c)))
+                seen_n[name] += int(np.count_nonzero(on_seen & (seen.labels == c)))
+            hidden = on_bare & ~on_seen
+            for name, c in _HIDERS.items():
+                hidden_n[name] += int(np.count_nonzero(hidden & (seen.labels == c)))
+    area = pixel_m * pixel_m
+    return ({k: n * area for k, n in bare_n.items()}, {k: n * area for k, n in seen_n.items()},
+            {k: n * area for k, n in hidden_n.items() if n})
