@@ -90,6 +90,24 @@ def import_citygml(path: str | Path, *, config: CityGmlConfig | None = None
             for model in [read_citygml(path)] for b in benchmark_buildings(model)]
 
 
+def import_citygml_building(path: str | Path, name: str, *,
+                            config: CityGmlConfig | None = None) -> Building:
+    """The building of ``path`` whose scene name is ``name`` (:func:`benchmark_buildings`):
+    what a resumable run re-imports in a worker for one scene.
+
+    Raises
+    ------
+    CityGmlError
+        As :func:`import_citygml`, or no building of that name in the file.
+    """
+    config = CityGmlConfig() if config is None else config
+    model = read_citygml(path)
+    for b in benchmark_buildings(model):
+        if b.gml_id == name:
+            return building_from_citygml(model, b, config=config)
+    raise CityGmlError(f"{path} holds no building {name!r}")
+
+
 def benchmark_buildings(model: CityModel) -> list[CityBuilding]:
     """The buildings of ``model`` that become scenes, their ids made scene names.
 

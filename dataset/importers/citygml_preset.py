@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from dataset.core.truth import Building
-from dataset.importers.citygml_import import import_citygml
+from dataset.importers.citygml_import import import_citygml_building
 
 LOD3_DIR = Path(__file__).resolve().parents[1] / "examples" / "lod3_ingolstadt"
 MANIFEST = "buildings.json"
@@ -54,7 +54,4 @@ def build_lod3_building(entry_id: str, file: str, folder: Path = LOD3_DIR) -> Bu
     ValueError
         The file does not hold a building of that id.
     """
-    for building in import_citygml(Path(folder) / file):
-        if building.truth.id == entry_id:
-            return building
-    raise ValueError(f"{Path(folder) / file} holds no building {entry_id!r}")
+    return import_citygml_building(Path(folder) / file, entry_id)
