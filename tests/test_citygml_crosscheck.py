@@ -18,6 +18,7 @@ from dataset.core.truth import Building
 from dataset.importers.citygml_crosscheck import check_facades
 from dataset.importers.citygml_import import import_citygml
 from dataset.importers.citygml_polygons import triangulate_polygon
+from dataset.importers.citygml_preset import LOD3_DIR
 from dataset.importers.citygml_read import read_citygml
 
 FIXTURES = Path(__file__).parent / "fixtures" / "citygml"
@@ -30,9 +31,12 @@ def _totals(checks, attr: str) -> tuple[float, float]:
     return window, gross
 
 
-@pytest.mark.parametrize("building_id", ["4018259", "4018133", "4018149b"])
-def test_rendered_labels_agree_with_the_truth(building_id):
-    building = import_citygml(FIXTURES / f"{building_id}.xml.xz")[0]
+@pytest.mark.parametrize("path", [FIXTURES / "4018259.xml.xz", FIXTURES / "4018133.xml.xz",
+                                  FIXTURES / "4018149b.xml.xz",
+                                  # a door whose region GEOS's floating overlay lost (-4.4 %)
+                                  LOD3_DIR / "4018207.xml.xz"], ids=lambda p: p.name)
+def test_rendered_labels_agree_with_the_truth(path):
+    building = import_citygml(path)[0]
     checks = check_facades(building)
     truth_window, truth_gross = _totals(checks, "truth_m2")
     bare_window, bare_gross = _totals(checks, "bare_m2")
