@@ -189,7 +189,7 @@ def _union_uv(tri_m: np.ndarray, tangent: np.ndarray) -> Polygon | MultiPolygon:
     uv = np.stack([tri_m @ tangent, tri_m[:, :, 2]], axis=-1)  # (T, 3, 2)
     d1, d2 = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
     keep = 0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) >= MIN_AREA_M2
-    return shapely.union_all(shapely.polygons(uv[keep]), grid_size=GRID_M)
+    return _polygonal(shapely.union_all(shapely.polygons(uv[keep]), grid_size=GRID_M))
 
 
 def _visible_uv(tri_m: np.ndarray, walls: list[PolygonTriangles], wall_polys: list,
@@ -213,9 +213,9 @@ def _visible_uv(tri_m: np.ndarray, walls: list[PolygonTriangles], wall_polys: li
         if mask.any():
             hiding = shapely.union_all([wall_polys[j] for j in np.flatnonzero(mask)],
                                        grid_size=GRID_M)
-            region = shapely.difference(region, hiding, grid_size=GRID_M)
+            region = _polygonal(shapely.difference(region, hiding, grid_size=GRID_M))
         parts.append(region)
-    return shapely.union_all(parts, grid_size=GRID_M)
+    return _polygonal(shapely.union_all(parts, grid_size=GRID_M))
 
 
 def _polygon_uv(surface: Surface, tangent: np.ndarray):
@@ -228,7 +228,7 @@ def _regions(surfaces, group, walls, openings, config) -> FacadeRegions:
     n = np.asarray(group.normal, dtype=np.float64)
     t = np.cross(_UP, n)
     wall_polys = [_polygon_uv(surfaces[i], t) for i in walls]
-    wall_union = shapely.union_all(wall_polys, grid_size=GRID_M)
+    wall_union = _polygonal(shapely.union_all(wall_polys, grid_size=GRID_M))
     regions: dict[str, list] = {"window": [], "door": []}
     opening_uv = {}
     depth = {}
@@ -244,9 +244,10 @@ def _regions(surfaces, group, walls, openings, config) -> FacadeRegions:
     taken = Polygon()
     for o in sorted(opening_uv, key=lambda o: (-depth[o], o)):
         kind, region = opening_uv[o]
-        regions[kind].append(shapely.difference(region, taken, grid_size=GRID_M))
-        taken = shapely.union(taken, region, grid_size=GRID_M)
-    covered = shapely.union_all([r for _, r in opening_uv.values()], grid_size=GRID_M)
+        regions[kind].append(_polygonal(shapely.difference(region, taken, grid_size=GRID_M)))
+        taken = _polygonal(shapely.union(taken, region, grid_size=GRID_M))
+    covered = _polygonal(shapely.union_all([r for _, r in opening_uv.values()],
+                                           grid_size=GRID_M))
     fill_tris, fill_kind = [], []
     for i, poly in zip(walls, wall_polys):
         for hole in _holes(poly):
@@ -257,26 +258,33 @@ def _regions(surfaces, group, walls, openings, config) -> FacadeRegions:
                 continue
             kind = max(opening_uv.values(), key=lambda kr: _area(
                 shapely.intersection(kr[1], hole, grid_size=GRID_M)))[0]
-            rim = shapely.difference(hole, covered, grid_size=GRID_M)
+            rim = _polygonal(shapely.difference(hole, covered, grid_size=GRID_M))
             regions[kind].append(rim)
             tris = _lift(_triangulate_uv(rim), surfaces[i].tri, n, t)
             fill_tris.append(tris)
             fill_kind += [kind] * len(tris)
-    window = shapely.union_all(regions["window"], grid_size=GRID_M)
-    door = shapely.difference(shapely.union_all(regions["door"], grid_size=GRID_M), window,
-                              grid_size=GRID_M)  # a hole's rim: the window wins
-    gross = shapely.union_all([wall_union, window, door], grid_size=GRID_M)
+    window = _polygonal(shapely.union_all(regions["window"], grid_size=GRID_M))
+    door = _polygonal(shapely.difference(  # a hole's rim: the window wins
+        shapely.union_all(regions["door"], grid_size=GRID_M), window, grid_size=GRID_M))
+    gross = _polygonal(shapely.union_all([wall_union, window, door], grid_size=GRID_M))
     u0, _, u1, v1 = gross.bounds
     above = box(u0 - 1.0, 0.0, u1 + 1.0, max(v1, 0.0) + 1.0)
-    gross, window, door = (shapely.intersection(r, above, grid_size=GRID_M)
+    gross, window, door = (_polygonal(shapely.intersection(r, above, grid_size=GRID_M))
                            for r in (gross, window, door))
-    wall = shapely.difference(gross, shapely.union_all([window, door], grid_size=GRID_M),
-                              grid_size=GRID_M)
+    wall = _polygonal(shapely.difference(
+        gross, shapely.union_all([window, door], grid_size=GRID_M), grid_size=GRID_M))
     return FacadeRegions(
         normal=n, tangent=t, offset_m=float(group.offset_m), surfaces=tuple(walls),
         openings=tuple(openings), gross=gross, window=window, door=door, wall=wall,
         fill_m=np.concatenate(fill_tris) if fill_tris else np.zeros((0, 3, 3)),
         fill_kind=tuple(fill_kind))
+
+
+def _polygonal(geometry):
+    """The polygons of an overlay's result (snap rounding can leave collapsed lines and
+    points beside them, which a later overlay refuses as mixed-dimension input)."""
+    parts = [g for g in shapely.get_parts(geometry) if isinstance(g, Polygon) and not g.is_empty]
+    return shapely.union_all(parts, grid_size=GRID_M) if parts else Polygon()
 
 
 def _area(geometry) -> float:
