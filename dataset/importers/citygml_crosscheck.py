@@ -30,9 +30,10 @@ from dataset.core.truth import Building
 from dataset.rendering.raycast import Raycaster
 from dataset.rendering.render import render_ground_truth
 
-PIXEL_M = 0.02
-"""Pixel size on the facade plane (2 cm: window edges fall on pixels at random, so the
-back-projected areas scatter by about edge length x pixel / sqrt(12) per window)."""
+PIXEL_M = 0.01
+"""Pixel size on the facade plane (1 cm). The models' corners sit on a centimetre grid, so
+coarser pixels alias with it: 2 cm pixels put 4018259's and 4018206's windows 0.6-0.8 %
+low, 1 cm pixels within 0.02 %."""
 CAMERA_DISTANCE_M = 2000.0
 TILE_PX = 1024
 _UP = np.array([0.0, 0.0, 1.0])
