@@ -57,3 +57,35 @@ def test_lod3_preset_lists_the_shipped_buildings():
 def test_lod3_recipe_builds_the_same_building_as_the_fixture():
     (recipe,) = [r for r in preset_recipes("lod3") if r.id == "4018259"]
     assert build_building(recipe).truth == import_citygml(FIXTURES / "4018259.xml.xz")[0].truth
+
+
+def test_make_lod3_copies_files_with_windows_and_writes_the_manifest(tmp_path):
+    """The maker of the shipped folder, on a miniature clone: two buildings with windows and
+    one file without any building window (the OGC house's 2.0 file has two, so an edited
+    copy without its windows stands in)."""
+    import lzma
+
+    from dataset.importers.citygml_preset import main as make_main
+
+    src = tmp_path / "models" / "building" / "lod3" / "individual" / "citygml"
+    for i in ("4018259", "4018133"):
+        (src / i).mkdir(parents=True)
+        (src / i / f"{i}.xml").write_bytes(lzma.decompress((FIXTURES / f"{i}.xml.xz")
+                                                           .read_bytes()))
+    bare = lzma.decompress((FIXTURES / "4018149b.xml.xz").read_bytes()).decode()
+    start = bare.index("<bldg:opening>")
+    while "<bldg:opening>" in bare:
+        start = bare.index("<bldg:opening>")
+        bare = bare[:start] + bare[bare.index("</bldg:opening>", start) + 15:]
+    (src / "4018149b").mkdir()
+    (src / "4018149b" / "4018149b.xml").write_text(bare)
+    (src.parents[1] / "LICENSE").write_text("Attribution-ShareAlike 4.0 International\n")
+    out = tmp_path / "out"
+    assert make_main([str(src), "--out", str(out)]) == 0
+    entries = lod3_entries(out)
+    assert [e.id for e in entries] == ["4018133", "4018259"]
+    assert sorted(p.name for p in out.glob("*.xz")) == ["4018133.xml.xz", "4018259.xml.xz"]
+    assert lzma.decompress((out / "4018259.xml.xz").read_bytes()) == (
+        src / "4018259" / "4018259.xml").read_bytes()
+    assert (out / "LICENSE").read_text().startswith("Attribution-ShareAlike")
+    assert make_main([str(tmp_path / "nowhere"), "--out", str(out)]) == 2
