@@ -21,8 +21,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from dataset.importers.citygml_crosscheck import PIXEL_M, check_facades  # noqa: E402
+from dataset.importers.citygml_files import citygml_files  # noqa: E402
 from dataset.importers.citygml_import import import_citygml  # noqa: E402
-from dataset.importers.citygml_read import citygml_files  # noqa: E402
 
 AGREE = 0.02
 

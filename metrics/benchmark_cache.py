@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,10 +11,9 @@ DEFAULT_CACHE = Path(".cache/envelope-bench")
 
 @dataclass(frozen=True)
 class DefaultBenchmark:
-    """The default run's benchmark (preset, image size, views, generator workers) and
-    neural3d's step budget and extraction resolution: the budget is the smallest measured
-    one with every building within WWR error 5 % and footprint IoU 0.96 (docs/decisions.md);
+    """The default run's benchmark (preset, image size, views, generator workers);
     ``expected_minutes`` is the measured wall time of the whole default run on 2 cores.
+    Each method's settings in this run are its own (``Method.short_run``).
 
     ``root / preset`` is the benchmark folder (relative to the working folder).
     """
@@ -23,27 +23,24 @@ class DefaultBenchmark:
     resolution: int = 128
     views: int = 40
     workers: int = 2
-    neural3d_steps: int = 2000
-    neural3d_resolution: int = 128
-    neural3d_eval_frames: int = 1
     expected_minutes: float = 11.0
 
     @property
     def folder(self) -> Path:
         return self.root / self.preset
 
-    def announce(self, methods: tuple[str, ...], neural3d_steps: int,
+    def announce(self, methods: tuple[str, ...], steps: Mapping[str, int],
                  comparisons: int = 1) -> str:
-        """The line printed before the default run starts; ``comparisons`` > 1 for a study
-        that repeats the default comparison (with every method) that many times."""
+        """The line printed before the default run starts: ``steps``, the training steps
+        per building of the methods that train; ``comparisons`` > 1 for a study that
+        repeats the default comparison (with every method) that many times."""
         made = "cached" if self.folder.is_dir() else "to be generated"
         repeated = (f", {comparisons} comparisons (clean and degraded inputs)"
                     if comparisons > 1 else "")
         return (
             f"Built-in default: the '{self.preset}' benchmark ({made} in {self.folder}, "
             f"{self.resolution} px, {self.views} orbit views), methods {', '.join(methods)}"
-            + (f", neural3d {neural3d_steps} training steps per building" if "neural3d" in methods
-               else "")
+            + "".join(f", {name} {n} training steps per building" for name, n in steps.items())
             + f"{repeated}. This takes up to about {self.expected_minutes * comparisons:g} "
             f"minutes on 2 CPU cores."
         )

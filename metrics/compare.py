@@ -1,19 +1,23 @@
 """``python -m metrics.compare``: run what is missing, then print and write Tables 2 and 3.
 
 With no arguments it runs the built-in default (the ``tiny`` benchmark, made
-into a cache folder on first use, every method, both view protocols, neural3d
-for a short CPU budget). With ``--data`` it compares on a benchmark or a
-user's scenes. Outputs (``--out``): the tables as CSV, Markdown and LaTeX,
-per-building and per-facade CSVs, plots (PNG + PDF), ``provenance.json``, the
-estimated footprints, the 2D-SS pipeline images of one facade and, for each
-method that keeps a mesh (neural3d), ``<method>_runs.json`` pointing at its
-meshes: everything ``figures.make`` reads;
+into a cache folder on first use, every method, both view protocols, each
+method's short-run settings, ``Method.short_run``). With ``--data`` it compares
+on a benchmark or a user's scenes. Outputs (``--out``): the tables as CSV,
+Markdown and LaTeX, per-building and per-facade CSVs, plots (PNG + PDF),
+``provenance.json``, the estimated footprints, the pipeline images of one facade
+(of the first method that writes them) and, for each method that keeps a mesh,
+``<method>_runs.json`` pointing at its meshes: everything ``figures.make`` reads;
 then ``report.html``, all of it in one offline page (:mod:`metrics.html_report`).
+
+Its modes are small functions: :func:`compare_once` (with ``--degrade``, on
+degraded inputs), :func:`robustness_study` (``--robustness``) and
+:func:`explain_one` (``--explain``); ``main`` works out the folders once
+(:func:`metrics.compare_args.compare_request`).
 """
 
 from __future__ import annotations
 
-import argparse
 import shutil
 import sys
 import time
@@ -24,14 +28,13 @@ from pathlib import Path
 
 from dataset.core.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from dataset.core.cli_errors import check_output_folder, run_cli
-from dataset.core.device import resolve_device
+from dataset.core.method import available_methods
 from dataset.core.results import code_version
 from dataset.core.truth import BuildingTruth, read_building
-from dataset.degrade.spec import parse_specs
 from dataset.executors.ray_tasks import RayConfig
-from metrics.aggregate import aggregate_by_family
-from metrics.benchmark_cache import DefaultBenchmark, ensure_benchmark
-from metrics.compare_args import neural3d_config, parse_compare_args, study_config
+from metrics.aggregate import GroupSummary, aggregate_by_family
+from metrics.benchmark_cache import ensure_benchmark
+from metrics.compare_args import CompareRequest, compare_request, parse_compare_args
 from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import (
     NO_TRUTH_FAMILY,
@@ -42,7 +45,7 @@ from metrics.errors import (
 )
 from metrics.errors import failed_building as failed_row
 from metrics.executors import make_executor
-from metrics.explain import explain, methods_provenance_text, run_timings
+from metrics.explain import explain, methods_provenance_text, recorded_steps, run_timings
 from metrics.html_report import write_report
 from metrics.mesh_pointers import write_mesh_pointers
 from metrics.methods import list_methods, method_specs
@@ -54,6 +57,14 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
+from metrics.report_paper import (
+    PAPER_TABLE2_NAME,
+    PAPER_TABLE3_NAME,
+    paper_table2_comparison,
+    paper_table3_comparison,
+)
+from metrics.report_seeds import SEED_TABLE_NAME, seed_spread_table
+from metrics.report_visible import TABLE2_VISIBLE_NAME, table2_visible_errors
 from metrics.robustness import RobustnessStudy, robustness_table, run_study
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -62,6 +73,7 @@ PROVENANCE_FILE = "provenance.json"
 PIPELINE_FOLDER = "2dss_pipeline"
 FOOTPRINTS_FOLDER = "footprints"
 PLOTS_FOLDER = "plots"
+CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME)
 
 
 @dataclass(frozen=True)
@@ -73,6 +85,7 @@ class Comparison:
     table2: Table
     table3: Table
     outcomes: tuple[Outcome, ...]
+    more_tables: tuple[Table, ...] = ()  # against the visible truth, seed spread, the paper's
 
 
 def compare(
@@ -114,12 +127,16 @@ def compare(
         table2=replace(table2, notes=(*table2.notes, footer)),
         table3=replace(table3, notes=(*table3.notes, footer)),
         outcomes=tuple(outcomes),
+        more_tables=claims_tables(groups),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
     comment = f"produced by `{command}`; {footer}"
     out_dir.mkdir(parents=True, exist_ok=True)
-    for table in (comparison.table2, comparison.table3):
+    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
         write_table(table, out_dir, comment)
+    for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
+        for suffix in (".csv", ".md", ".tex"):  # a table with no rows this time: none stale
+            (out_dir / f"{name}{suffix}").unlink(missing_ok=True)
     for table in (per_building_table(rows), per_facade_table(facade_rows),
                   timing_table(run_timings(outcomes))):
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
@@ -133,6 +150,15 @@ def compare(
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
     _write_html_report(out_dir)
     return comparison
+
+
+def claims_tables(groups: Sequence[GroupSummary]) -> tuple[Table, ...]:
+    """Table 2 against the full and the visible facade truth, the seed-to-seed spread (when
+    a method ran with several seeds) and ours beside the BuildNet3D paper's Tables 2 and 3
+    (each only when it has a row)."""
+    tables = (table2_visible_errors(groups), seed_spread_table(groups),
+              paper_table2_comparison(groups), paper_table3_comparison(groups))
+    return tuple(t for t in tables if t is not None and t.rows)
 
 
 def evaluate(
@@ -255,76 +281,89 @@ def _keep_pipeline_images(scene_dirs: Sequence[Path], spec: MethodSpec, folder: 
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = parse_compare_args(argv)
+    methods = available_methods()
+    args = parse_compare_args(argv, methods)
     if args.list_methods:
         print("\n".join(list_methods()))
         return 0
+    argv_text = " ".join(sys.argv[1:] if argv is None else argv)
 
     def body() -> int:
-        start = time.perf_counter()
-        methods = tuple(m.strip() for m in args.methods.split(",") if m.strip())
-        views = tuple(v.strip() for v in args.views.split(",") if v.strip())
-        # A Ray cluster's GPUs are on its nodes, not here; --no-run and --explain run nothing.
-        runs_here = args.executor == "local" and not (args.no_run or args.explain)
-        resolve_device(args.device, available=runs_here)
-        execute = make_executor(args.executor, RayConfig(address=args.ray_address))
-        default = DefaultBenchmark() if args.data is None else None
-        configs = {"neural3d": neural3d_config(args, default)}
+        request = compare_request(args, methods)
         if args.explain:
-            return _explain(args, default, methods, views, configs)
-        study = (RobustnessStudy(seed=args.degrade_seed, heavy_levels=args.robustness_neural3d)
-                 if args.robustness else None)
-        if default is not None:
-            print(default.announce(methods, configs["neural3d"].steps,
-                                   study.heavy_comparisons if study else 1), flush=True)
-        data = (ensure_benchmark(default) if default is not None else args.data).resolve()
-        results = args.results or data.with_name(f"{data.name}-results")
-        out = args.out or data.with_name(f"{data.name}-compare")
-        check_output_folder(results, "--results")
-        check_output_folder(out, "--out")
-        if study is not None:
-            configs = study_config(configs)
-            rows = run_study(data, results / "robustness", out / "robustness",
-                             lambda r: method_specs(methods, views, r, configs=configs), study,
-                             compare)
-            print(to_text(robustness_table(rows)))
-            print(f"wrote robustness.csv/.md/.png to {out / 'robustness'}")
-            return 0
-        if args.degrade:
-            degradation = parse_specs(args.degrade, seed=args.degrade_seed)
-            run = degraded_run(data, results, out, degradation)
-            data, results, out = run.data, run.results, run.out
-        specs = method_specs(methods, views, results, configs=configs)
-        if args.degrade:
-            specs = with_degradation(specs, degradation)
-        argv_text = " ".join(sys.argv[1:] if argv is None else argv)
-        comparison = compare(data, specs, results, out, allow_run=not args.no_run,
-                             reuse_stale=args.reuse_stale,
-                             command=f"python -m metrics.compare {argv_text}".strip(),
-                             execute=execute)
-        print()
-        print(to_text(comparison.table2))
-        print(to_text(comparison.table3))
-        print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
-              f"(results in {results}); {time.perf_counter() - start:.0f} s")
-        return 0
+            return explain_one(request, *args.explain)
+        check_output_folder(request.results, "--results")
+        check_output_folder(request.out, "--out")
+        if args.robustness:
+            return robustness_study(request, RobustnessStudy(
+                seed=args.degrade_seed, heavy_levels=args.robustness_heavy))
+        return compare_once(
+            request, f"python -m metrics.compare {argv_text}".strip(),
+            allow_run=not args.no_run, reuse_stale=args.reuse_stale,
+            execute=make_executor(args.executor, RayConfig(address=args.ray_address)))
 
     return run_cli("metrics.compare", body, debug=args.debug, interrupted=(
         "interrupted: finished results are kept; run again to continue"))
 
 
-def _explain(args: argparse.Namespace, default: DefaultBenchmark | None,
-             methods: tuple[str, ...], views: tuple[str, ...], configs: dict) -> int:
-    """``--explain SCENE METHOD``: print one scene's result records of one method."""
-    scene, method = args.explain
-    data = (default.folder if default is not None else args.data).resolve()
-    results = args.results or data.with_name(f"{data.name}-results")
-    scene_dir = next((d for d in find_scenes(data) if d.name == scene), None)
-    if scene_dir is None:
-        raise ValueError(f"no scene {scene!r} in {data}")
-    (spec,) = method_specs((method,), views, results, configs=configs)
-    print(explain(scene_dir, spec, results))
+def compare_once(request: CompareRequest, command: str, *, allow_run: bool, reuse_stale: bool,
+                 execute: Execute) -> int:
+    """The comparison (on degraded copies of the scenes with ``--degrade``); print its tables."""
+    start = time.perf_counter()
+    _prepare(request)
+    data, results, out = request.data, request.results, request.out
+    if request.degradation:
+        run = degraded_run(data, results, out, request.degradation)
+        data, results, out = run.data, run.results, run.out
+    specs = _specs(request, results)
+    if request.degradation:
+        specs = with_degradation(specs, request.degradation)
+    comparison = compare(data, specs, results, out, allow_run=allow_run,
+                         reuse_stale=reuse_stale, command=command, execute=execute)
+    print()
+    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
+        print(to_text(table))
+    print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
+          f"(results in {results}); {time.perf_counter() - start:.0f} s")
     return 0
+
+
+def robustness_study(request: CompareRequest, study: RobustnessStudy) -> int:
+    """``--robustness``: the clean comparison and each degraded one; print the study's table."""
+    _prepare(request, study.heavy_comparisons)
+    out = request.out / "robustness"
+    rows = run_study(request.data, request.results / "robustness", out,
+                     lambda results: _specs(request, results), study, compare)
+    print(to_text(robustness_table(rows)))
+    print(f"wrote robustness.csv/.md/.png to {out}")
+    return 0
+
+
+def explain_one(request: CompareRequest, scene: str, method: str) -> int:
+    """``--explain SCENE METHOD``: print one scene's result records of one method."""
+    scene_dir = next((d for d in find_scenes(request.data) if d.name == scene), None)
+    if scene_dir is None:
+        raise ValueError(f"no scene {scene!r} in {request.data}")
+    for spec in method_specs((method,), request.views, request.results,
+                             configs=request.configs, seeds=request.seeds):
+        print(explain(scene_dir, spec, request.results))
+    return 0
+
+
+def _specs(request: CompareRequest, results: Path) -> list[MethodSpec]:
+    """The specs of the request's methods, keeping their artefacts under ``results``."""
+    return method_specs(request.methods, request.views, results, configs=request.configs,
+                        seeds=request.seeds)
+
+
+def _prepare(request: CompareRequest, comparisons: int = 1) -> None:
+    """For the built-in default run: say what it does, then generate its benchmark if absent."""
+    if request.default is None:
+        return
+    steps = {s.name: n for s in _specs(request, request.results)
+             if (n := recorded_steps(s.config)) is not None}
+    print(request.default.announce(request.methods, steps, comparisons), flush=True)
+    ensure_benchmark(request.default)
 
 
 if __name__ == "__main__":

@@ -1,29 +1,54 @@
-"""The command line of ``python -m metrics.compare``: its options, their help and defaults."""
+"""The command line of ``python -m metrics.compare``: its options, their help and defaults,
+and what one call compares (:class:`CompareRequest`, its folders worked out once).
+
+The methods' own options (``--device``, ...) and ``--set`` come from the methods
+(:mod:`metrics.method_args`).
+"""
 
 from __future__ import annotations
 
 import argparse
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from dataset.core.cli_errors import add_debug_flag
+from dataset.core.method import Method
 from dataset.core.protocols import VIEW_PROTOCOLS
-from dataset.degrade.spec import DEGRADATIONS
+from dataset.degrade.spec import DEGRADATIONS, DegradeSpec, parse_specs
 from dataset.executors.ray_tasks import add_executor_arguments
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
+from metrics.method_args import add_method_options, method_configs
 from metrics.methods import METHODS
-from neural3d.method import Neural3dBudget
 
 
-def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
-    """The options of ``python -m metrics.compare`` (``--help`` explains each)."""
+@dataclass(frozen=True)
+class CompareRequest:
+    """What one call compares: ``data`` (resolved), ``results`` and ``out`` (their
+    defaults worked out), the methods and views, each method's config, the built-in
+    default run (``default``, when ``--data`` is not given) and the ``--degrade`` specs."""
+
+    data: Path
+    results: Path
+    out: Path
+    methods: tuple[str, ...]
+    views: tuple[str, ...]
+    configs: dict[str, Any]
+    default: DefaultBenchmark | None
+    degradation: tuple[DegradeSpec, ...]
+    seeds: tuple[int, ...] = (0,)
+
+
+def parse_compare_args(argv: Sequence[str] | None,
+                       methods: Mapping[str, Method]) -> argparse.Namespace:
+    """The options of ``python -m metrics.compare`` (``--help`` explains each), with the
+    options that ``methods`` declare."""
     parser = argparse.ArgumentParser(
         prog="python -m metrics.compare",
         description=(
-            "Compare WWR / window / facade-area and footprint estimates of 2D-S, 2D-SS and "
-            "neural3d against ground truth, running only the results that are missing. "
+            "Compare WWR / window / facade-area and footprint estimates of the methods "
+            "(--list-methods) against ground truth, running only the results that are missing. "
             "Without --data it runs the built-in default: the tiny benchmark (generated into "
             f"{DEFAULT_CACHE}), all methods, about {DefaultBenchmark.expected_minutes:g} "
             "minutes on 2 CPU cores. Prints Table 2 "
@@ -36,45 +61,34 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--methods", default=",".join(METHODS),
                         help=f"comma-separated methods (default: {','.join(METHODS)})")
     parser.add_argument("--views", default=",".join(VIEW_PROTOCOLS),
-                        help="comma-separated view protocols of the 2D methods "
-                        "(default: ideal,multi); neural3d always uses its train views")
+                        help="comma-separated facade-view protocols of the methods that run "
+                        f"on them (default: {','.join(VIEW_PROTOCOLS)}); a method on the orbit "
+                        "views always uses those")
     parser.add_argument("--results", type=Path,
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,
                         help="folder for tables, plots, provenance (default: <data>-compare)")
-    parser.add_argument("--neural3d-steps", type=int,
-                        help="training steps per building for neural3d: the budget that fixes "
-                        "its result (default: the preset's own; the built-in default run uses "
-                        f"{DefaultBenchmark.neural3d_steps})")
-    parser.add_argument("--neural3d-max-minutes", type=float, default=Neural3dBudget.max_minutes,
-                        help="safety cap on neural3d's training time per building, minutes; a "
-                        "run it stops is marked 'cut short' in every table "
-                        f"(default: {Neural3dBudget.max_minutes:g})")
-    parser.add_argument("--neural3d-threads", type=int, default=Neural3dBudget.threads,
-                        help="torch CPU threads for neural3d (recorded with the result; "
-                        f"default: {Neural3dBudget.threads})")
-    parser.add_argument("--neural3d-preset", default=Neural3dBudget.preset,
-                        choices=("paper", "fast", "tiny"), help="neural3d training preset")
-    parser.add_argument("--neural3d-resolution", type=int,
-                        help="marching-cubes samples along the scene box's longest side "
-                        "(default: neural3d's own; the built-in default run uses "
-                        f"{DefaultBenchmark.neural3d_resolution})")
-    parser.add_argument("--device", default="cpu",
-                        help="torch device for neural3d: cpu or cuda (default: cpu)")
-    parser.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
+    parser.add_argument("--seeds", default="0",
+                        help="comma-separated training seeds of the methods whose config has a "
+                        "seed (neural3d): one result per seed and building (seed k > 0 in "
+                        "<scene>__<method>__<protocol>__seed<k>.json); the tables average a "
+                        "building's seeds, then bootstrap over buildings, and report the "
+                        "seed-to-seed spread (default: 0)")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
                         help="compare on degraded inputs (truth unchanged): "
                         f"{', '.join(DEGRADATIONS)}; see dataset/degrade/spec.py. Degraded "
                         "scenes are cached in <data>-degraded/, results go to "
                         "<results>/degraded/, outputs to <out>-<key>")
     parser.add_argument("--degrade-seed", type=int, default=0,
                         help="seed of the degradations (default: 0)")
-    parser.add_argument("--robustness", action="store_true",
+    mode.add_argument("--robustness", action="store_true",
                         help="run the robustness study (mask noise, occluders, pose and depth "
                         "noise at three severities each; results in <results>/robustness, "
                         "table and plot in <out>/robustness)")
-    parser.add_argument("--robustness-neural3d", choices=("all", "max"), default="max",
-                        help="robustness study: neural3d at every severity or only at the "
-                        "highest of each degradation (default: max)")
+    parser.add_argument("--robustness-heavy", choices=("all", "max"), default="max",
+                        help="robustness study: the heavy methods (those that train) at every "
+                        "severity or only at the highest of each degradation (default: max)")
     parser.add_argument("--no-run", action="store_true",
                         help="only read existing result files; never run a method (results "
                         "made by other code or settings are marked stale)")
@@ -84,44 +98,63 @@ def parse_compare_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser.add_argument("--list-methods", action="store_true",
                         help="list the built-in methods and those installed through the "
                         "envelope_bench.methods entry point group, then exit")
-    parser.add_argument("--explain", nargs=2, metavar=("SCENE", "METHOD"),
+    mode.add_argument("--explain", nargs=2, metavar=("SCENE", "METHOD"),
                         help="print the full provenance record of one scene's result(s) of one "
                         "method, and whether the current code would reuse it; runs nothing")
     add_executor_arguments(parser, "missing runs one after the other in this process",
                            "building, method and views")
     add_debug_flag(parser)
+    add_method_options(parser, methods)
     return parser.parse_args(argv)
 
 
-def neural3d_config(args: argparse.Namespace, default: DefaultBenchmark | None) -> Neural3dBudget:
-    """neural3d's config from the ``--neural3d-*`` options and ``--device``; the built-in
-    default run (``default``) fills the step budget, resolution and eval frames not given.
+def parse_seeds(text: str) -> tuple[int, ...]:
+    """``--seeds``: distinct non-negative integers, in the order given.
 
     Raises
     ------
     ValueError
-        If a value is out of range (0 steps included: a given 0 is not 'not given').
+        If an entry is not a non-negative integer or repeats.
     """
-    resolution = _given_or(args.neural3d_resolution,
-                           default.neural3d_resolution if default else None)
-    steps = _given_or(args.neural3d_steps, default.neural3d_steps if default else None)
-    return Neural3dBudget(
-        preset=args.neural3d_preset, steps=steps, max_minutes=args.neural3d_max_minutes,
-        threads=args.neural3d_threads, resolution=resolution,
-        eval_frames=default.neural3d_eval_frames if default else None, device=args.device,
-    )
+    try:
+        seeds = tuple(int(s) for s in text.split(",") if s.strip())
+    except ValueError:
+        raise ValueError(f"--seeds must be comma-separated integers, got {text!r}") from None
+    if not seeds or min(seeds) < 0 or len(set(seeds)) != len(seeds):
+        raise ValueError(f"--seeds needs distinct non-negative integers, got {text!r}")
+    return seeds
 
 
-def study_config(configs: Mapping[str, Any]) -> dict[str, Any]:
-    """The configs of a robustness study: neural3d with the given step budget, else the
-    built-in default's (:attr:`DefaultBenchmark.neural3d_steps`), one eval frame, and the
-    default run's marching-cubes resolution unless one was given."""
-    budget = configs["neural3d"]
-    return {**configs, "neural3d": replace(
-        budget, steps=budget.steps or DefaultBenchmark.neural3d_steps, eval_frames=1,
-        resolution=budget.resolution or DefaultBenchmark.neural3d_resolution)}
+
+def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> CompareRequest:
+    """What ``args`` asks to compare. Without ``--data``, the built-in default's folder
+    (not generated here); ``--results`` and ``--out`` default to ``<data>-results`` and
+    ``<data>-compare``; with ``--explain SCENE METHOD`` the one method is METHOD. The
+    methods' configs take their short-run values in the built-in default run and the
+    robustness study, and are checked for running here unless nothing runs in this
+    process (``--no-run``, ``--explain``, a Ray executor: its GPUs are on its nodes).
+
+    Raises
+    ------
+    ValueError
+        If a method option, ``--set`` or ``--degrade`` is refused.
+    """
+    default = DefaultBenchmark() if args.data is None else None
+    data = (default.folder if default is not None else args.data).resolve()
+    names = (args.explain[1],) if args.explain else _listed(args.methods)
+    runs_here = args.executor == "local" and not (args.no_run or args.explain)
+    configs = method_configs(args, methods, names, runs_here=runs_here,
+                             short_run=default is not None or args.robustness)
+    return CompareRequest(
+        data=data, results=args.results or data.with_name(f"{data.name}-results"),
+        out=args.out or data.with_name(f"{data.name}-compare"), methods=names,
+        views=_listed(args.views), configs=configs, default=default,
+        degradation=parse_specs(args.degrade, seed=args.degrade_seed) if args.degrade else (),
+        seeds=parse_seeds(args.seeds))
 
 
-def _given_or(given: int | None, fallback: int | None) -> int | None:
-    """A CLI value when given (0 included, so that the budget refuses it), else the fallback."""
-    return fallback if given is None else given
+def _listed(text: str) -> tuple[str, ...]:
+    """The items of a comma-separated option."""
+    return tuple(item.strip() for item in text.split(",") if item.strip())
+
+

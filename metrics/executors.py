@@ -6,8 +6,8 @@ outcome as it finishes; :func:`metrics.runner.run_missing` writes the result
 files. ``ray`` makes one Ray task per (scene, method, protocol) and assumes no
 shared file system: each scene folder is packed once into the object store
 and unpacked by the worker into a temporary folder; the outcome and the
-method's artefacts folder (neural3d's run folder, with ``extract/mesh.ply``
-and ``footprint.geojson``) come back, and this process alone writes them,
+method's artefacts folder (a trained method's run folder, with its mesh
+and footprint) come back, and this process alone writes them,
 atomically. Each task reserves its spec's ``resources``; a task whose worker
 dies is re-run up to ``RayConfig.max_retries`` times and then recorded as a
 failed run, like a method that fails on its input (which is not re-run).

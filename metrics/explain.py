@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 from dataset.core.provenance import code_version, provenance_changes
 from dataset.core.results import read_result, result_filename
@@ -21,8 +22,9 @@ from metrics.runner import MethodSpec, Outcome, expected_provenance
 def methods_provenance_text(specs: Sequence[MethodSpec]) -> str:
     """One line naming, per method, its budget (if any), code fingerprints and config digest.
 
-    E.g. ``"2D-SS: code dataset@1a2b.. baselines@3c4d.., config 5e6f..; neural3d: fast
-    preset, 1000 steps (cap 60 min), cpu, 2 threads, code ..."``.
+    E.g. ``"2D-SS: code dataset@1a2b.. baselines@3c4d.., config 5e6f..; NAME: fast
+    preset, 1000 steps (cap 60 min), cpu, 2 threads, code ..."`` (the budget, for a
+    method whose config record has one: :func:`recorded_steps`).
     """
     parts = []
     for spec in specs:
@@ -30,12 +32,19 @@ def methods_provenance_text(specs: Sequence[MethodSpec]) -> str:
         code = " ".join(f"{m}@{fp}" for m, fp in record.code.items())
         budget = spec.config.get("budget")
         said = ""
-        if isinstance(budget, dict) and "steps" in budget:
+        if recorded_steps(spec.config) is not None:
             said = (f"{budget.get('preset')} preset, {budget['steps']} steps "
                     f"(cap {budget.get('max_seconds', 0) / 60:g} min), "
                     f"{budget.get('device')}, {budget.get('threads')} threads, ")
         parts.append(f"{spec.name}: {said}code {code}, config {_config_digest(spec)}")
     return f"envelope-bench {code_version()}; " + "; ".join(parts)
+
+
+def recorded_steps(config: Mapping[str, Any]) -> int | None:
+    """The training steps per building that a method's config record names as its budget
+    (``config["budget"]["steps"]``), or ``None`` for a method that does not train."""
+    budget = config.get("budget")
+    return budget["steps"] if isinstance(budget, dict) and "steps" in budget else None
 
 
 def run_timings(outcomes: Sequence[Outcome]) -> list[RunTiming]:

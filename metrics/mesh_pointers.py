@@ -1,4 +1,4 @@
-"""``<method>_runs.json``: where the meshes of a method that keeps one (neural3d) are.
+"""``<method>_runs.json``: where the meshes of a method that keeps one (``mesh_file``) are.
 
 :mod:`metrics.compare` writes one such file per method with a ``mesh_file``
 (:class:`dataset.core.method.Method`) into its output folder; the HTML report and

@@ -32,7 +32,7 @@ SpecsFor = Callable[[Path], list[MethodSpec]]
 class RobustnessStudy:
     """Degradations and severities of the study (a laptop's worth on the tiny benchmark).
 
-    ``heavy_levels``: ``"all"`` runs the heavy methods (``Method.heavy``: neural3d) at
+    ``heavy_levels``: ``"all"`` runs the heavy methods (``Method.heavy``, a trained one) at
     every severity, ``"max"`` only at the highest of each degradation (the default; the
     2D methods always run at all).
     """

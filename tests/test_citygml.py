@@ -19,9 +19,11 @@ from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import geojson_to_polygon
 from dataset.core.mesh import write_labelled_ply
 from dataset.core.truth import write_building
-from dataset.importers.citygml_import import azimuth_deg, import_citygml
+from dataset.importers.citygml_files import citygml_files, citygml_stem
+from dataset.importers.citygml_import import import_citygml
 from dataset.importers.citygml_polygons import newell_normal
-from dataset.importers.citygml_read import citygml_files, citygml_stem, read_citygml
+from dataset.importers.citygml_read import read_citygml
+from dataset.importers.grid_north import grid_north_deg
 
 FIXTURES = Path(__file__).parent / "fixtures" / "citygml"
 IDS = ("4018259", "4018133", "4018149b")
@@ -164,15 +166,17 @@ def test_import_twice_gives_identical_files(tmp_path):
 
 
 def test_covered_rule_on_a_street_house(imported):
-    """4018259 stands with its street front facing SSE (azimuth ~165 degrees): that facade
-    carries every window but the bay's; the backyard wall (~345) and the side walls against
-    the neighbours (~75, ~262) have none and are not covered."""
+    """4018259 stands with its street front facing SSE (azimuth ~167 degrees from true north,
+    ~165 from grid north): that facade carries every window but the bay's; the backyard
+    wall (~347) and the side walls against the neighbours (~77, ~264) have none and are not
+    covered."""
     truth = imported["4018259"].truth
     street = max(truth.facades, key=lambda f: f.facade_area_m2)
-    assert truth.extra["facades"][str(street.id)]["azimuth_deg"] == pytest.approx(164.8, abs=0.5)
+    assert street.azimuth_deg == pytest.approx(164.8 + 1.82, abs=0.5)
+    assert street.orientation == "S"
     assert street.window_area_m2 / truth.window_area_m2 > 0.9
     uncovered = sorted(round(u["azimuth_deg"]) for u in truth.extra["uncovered_facades"])
-    assert uncovered == [75, 75, 262, 345]
+    assert uncovered == [77, 77, 264, 347]
     assert all(u["wall_area_m2"] > 0 for u in truth.extra["uncovered_facades"])
     # Uncovered walls stay in the mesh as wall, without a facade id (no views, no truth).
     mesh = imported["4018259"].mesh
@@ -186,11 +190,30 @@ def test_data_available_is_recorded_not_used(imported):
     assert imported["4018149b"].truth.facades  # NotSufficient buildings keep their facades
 
 
-def test_azimuth_is_clockwise_from_grid_north():
-    assert azimuth_deg(np.array([0.0, 1.0, 0.0])) == pytest.approx(0.0)
-    assert azimuth_deg(np.array([1.0, 0.0, 0.0])) == pytest.approx(90.0)
-    assert azimuth_deg(np.array([0.0, -1.0, 0.0])) == pytest.approx(180.0)
-    assert azimuth_deg(np.array([-1.0, 0.0, 0.0])) == pytest.approx(270.0)
+def test_north_is_the_utm_grid_convergence(imported):
+    """World +y is EPSG:32632's grid north; north_deg is the meridian convergence at the
+    building. Closed form on the sphere: gamma = atan(tan(lon - 9 E) sin(lat)), within
+    0.01 degrees of the ellipsoidal value at these distances from the meridian."""
+    import math
+
+    import pyproj
+
+    truth = imported["4018259"].truth
+    assert truth.north_source == "crs_convergence"
+    x, y = -np.asarray(truth.extra["offset_m"][:2])
+    lon, lat = pyproj.Transformer.from_crs("EPSG:32632", "EPSG:4326",
+                                           always_xy=True).transform(x, y)
+    gamma = math.degrees(math.atan(math.tan(math.radians(lon - 9.0))
+                                   * math.sin(math.radians(lat))))
+    assert truth.north_deg == pytest.approx(gamma, abs=0.01)
+    assert truth.north_deg == pytest.approx(1.82, abs=0.01)  # Ingolstadt, 11.4 E 48.8 N
+    assert grid_north_deg("EPSG:32632", 500000.0, 5_400_000.0) == pytest.approx(0.0, abs=1e-9)
+    west = grid_north_deg("EPSG:32632", 300000.0, 5_400_000.0)
+    assert west < 0  # west of the central meridian grid north lies anticlockwise of true
+    with pytest.raises(ValueError, match="not projected"):
+        grid_north_deg("EPSG:4326", 11.0, 48.0)
+    with pytest.raises(ValueError, match="unknown to PROJ"):
+        grid_north_deg("EPSG:999999", 0.0, 0.0)
 
 
 def test_classes_and_what_is_left_out(imported):

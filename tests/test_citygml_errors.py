@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 from lxml import etree
 
+from dataset.importers.citygml_files import CityGmlError
 from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_read import CityGmlError, read_citygml
+from dataset.importers.citygml_read import read_citygml
 
 FIXTURE = Path(__file__).parent / "fixtures" / "citygml" / "4018259.xml.xz"
 

@@ -5,12 +5,16 @@ The package is the worked example of docs/adding-a-method.md, read from the page
 
 import contextlib
 import io
+import json
 import re
 import sys
 from pathlib import Path
 
+import pytest
+
 from dataset.core.method import ENTRY_POINT_GROUP, installed_methods
 from metrics.compare import main
+from metrics.report import read_building_errors_csv
 from metrics.tables import read_csv_rows
 
 DOC = Path(__file__).resolve().parent.parent / "docs" / "adding-a-method.md"
@@ -61,5 +65,49 @@ def test_a_plugin_method_is_listed_and_compared(tiny_benchmark, tmp_path, monkey
         assert sum(r["method"] == "toy" for r in per_building) == 3
         assert (out / "plots" / "wwr_scatter.png").is_file()
         assert (tmp_path / "results" / "tiny_skyscraper__toy__ideal.json").is_file()
+    finally:
+        sys.modules.pop("toy_wwr_plugin", None)
+
+
+def test_a_plugin_declares_its_own_option(tiny_benchmark, tmp_path, monkeypatch, capsys):
+    """The toy's ``--toy-noise`` is in ``--help`` and sets its config, as ``--set`` does."""
+    (tmp_path / "site").mkdir()
+    _install_toy_package(tmp_path / "site", monkeypatch)
+    monkeypatch.setenv("COLUMNS", "200")  # argparse wraps the help at the terminal's width
+    try:
+        with pytest.raises(SystemExit) as stopped:
+            main(["--help"])
+        assert stopped.value.code == 0
+        help_text = capsys.readouterr().out
+        assert "toy options:" in help_text
+        assert re.search(r"\n  --toy-noise NOISE +constant added to the WWR; default: 0\n",
+                         help_text)
+
+        def wwr_est(name: str, *extra: str) -> dict[str, float]:
+            out = tmp_path / name
+            with contextlib.redirect_stdout(io.StringIO()):
+                assert main(["--data", str(tiny_benchmark), "--methods", "toy", "--views",
+                             "ideal", "--results", str(tmp_path / "results"), "--out",
+                             str(out), *extra]) == 0
+            return {r.scene: r.wwr_est for r in read_building_errors_csv(out / "per_building.csv")}
+
+        plain = wwr_est("plain")
+        flagged = wwr_est("flagged", "--toy-noise", "0.25")
+        both = wwr_est("both", "--toy-noise", "0.25", "--set", "toy.noise=0.5")  # --set wins
+        assert len(plain) == 3
+        assert flagged == pytest.approx({s: w + 0.25 for s, w in plain.items()}, abs=1e-12)
+        assert both == pytest.approx({s: w + 0.5 for s, w in plain.items()}, abs=1e-12)
+        provenance = json.loads((tmp_path / "both" / "provenance.json").read_text())
+        assert provenance["methods"]["toy"]["config"] == {"noise": 0.5}
+        capsys.readouterr()
+        with pytest.raises(SystemExit) as stopped:
+            main(["--methods", "toy", "--toy-noise", "lots"])
+        assert stopped.value.code == 2
+        assert "noise takes a number, got 'lots'" in capsys.readouterr().err
+        assert main(["--data", str(tiny_benchmark), "--methods", "toy", "--no-run",
+                     "--out", str(tmp_path / "o"), "--set", "toy.nosie=1"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("error: --set toy.nosie=1: toy: ToyConfig has no field 'nosie'; "
+                              "its fields: noise")
     finally:
         sys.modules.pop("toy_wwr_plugin", None)

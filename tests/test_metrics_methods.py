@@ -61,14 +61,14 @@ def test_budget_must_be_positive():
 
 def test_default_benchmark_announces_what_it_does(tmp_path):
     default = DefaultBenchmark(root=tmp_path)
-    line = default.announce(("2D-S", "neural3d"), 1000)
+    line = default.announce(("2D-S", "neural3d"), {"neural3d": 1000})
     assert f"to be generated in {tmp_path / 'tiny'}" in line
     assert "neural3d 1000 training steps per building" in line
     assert f"about {default.expected_minutes:g} minutes on 2 CPU cores" in line
-    assert "neural3d" not in default.announce(("2D-S",), 1000).split("methods")[1]
+    assert "neural3d" not in default.announce(("2D-S",), {}).split("methods")[1]
     study = RobustnessStudy()  # clean + one neural3d comparison per degradation
     assert study.heavy_comparisons == 5
     assert RobustnessStudy(heavy_levels="all").heavy_comparisons == 13
-    line = default.announce(("2D-S", "neural3d"), 1000, study.heavy_comparisons)
+    line = default.announce(("2D-S", "neural3d"), {"neural3d": 1000}, study.heavy_comparisons)
     assert "5 comparisons" in line
     assert f"about {5 * default.expected_minutes:g} minutes" in line

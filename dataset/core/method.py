@@ -1,10 +1,19 @@
-"""The method interface: what a method declares, and how external packages register one.
+"""The method interface: what a method declares, and how packages register one.
 
 A :class:`Method` has a name, the inputs it reads, the protocols it runs on,
-the resources it needs, its config type and ``run(scene, protocol, config) ->
-MethodResult``. 2D-S and 2D-SS are declared in :mod:`baselines.methods`,
-neural3d in :mod:`neural3d.method`; ``metrics`` runs every method through this
-record (``metrics.methods``) and knows no method by name.
+the resources it needs, its config type, the command-line options that set its
+config and ``run(scene, protocol, config) -> MethodResult``. 2D-S and 2D-SS are
+declared in :mod:`baselines.methods`, neural3d in :mod:`neural3d.method`, and
+registered in :data:`BUILT_IN` as a plugin is under its entry point; ``metrics``
+runs every method through this record (``metrics.methods``) and knows no method
+by name.
+
+The truth is out of a method's reach: ``scene`` is a
+:class:`~dataset.core.method_input.MethodInput` (images, poses, intrinsics, and the depth
+and semantic images the method declares in ``inputs``), never the
+:class:`~dataset.core.scene_record.Scene` with its ``building.json``; metrics reads the
+truth itself. A method's results must not change when ``building.json``, ``mesh.ply`` or
+the facade-id images are removed (``tests/test_truth_blind.py`` checks the built-in ones).
 
 Another package adds a method without touching this repository by exposing a
 :class:`Method` (or a zero-argument callable returning one) under the entry
@@ -18,29 +27,41 @@ point group ``envelope_bench.methods``, e.g. in its ``pyproject.toml``::
 
 from __future__ import annotations
 
+import importlib
 import sys
-from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, field
 from importlib.metadata import entry_points
 from typing import Any, Literal
 
+from dataset.core.method_input import Input
+from dataset.core.method_options import Option, field_type
 from dataset.core.protocols import Protocol
 from dataset.core.results import MethodResult
 
 ENTRY_POINT_GROUP = "envelope_bench.methods"
-Input = Literal["rgb", "semantics", "depth", "poses"]
+# The project's own methods, as ``module:attribute`` like an entry point's value, in table
+# order: a string, so that this core names no package later in the data flow.
+BUILT_IN: dict[str, str] = {
+    "2D-S": "baselines.methods:METHOD_2DS",
+    "2D-SS": "baselines.methods:METHOD_2DSS",
+    "neural3d": "neural3d.method:METHOD_NEURAL3D",
+}
 Resource = Literal["cpu", "gpu"]
 RunMethod = Callable[..., MethodResult]
-"""``run(scene, protocol, config) -> MethodResult`` for one scene; may raise. A method with an
-``artefacts`` folder is called ``run(scene, protocol, config, artefacts_dir=FOLDER)`` and writes
-its folder for the scene (named by the scene) into ``FOLDER``."""
+"""``run(scene, protocol, config) -> MethodResult`` for one scene, ``scene`` a
+:class:`~dataset.core.method_input.MethodInput`; may raise. A method with an ``artefacts``
+folder is called ``run(scene, protocol, config, artefacts_dir=FOLDER)`` and writes its folder
+for the scene (named by the scene) into ``FOLDER``."""
 
 
 @dataclass(frozen=True)
 class Method:
     """A benchmark method.
 
-    ``inputs``: what it reads from a scene (never the truth). ``protocols``:
+    ``inputs``: what it reads from a scene (never the truth): its
+    :class:`~dataset.core.method_input.MethodInput` holds the depth and semantic images
+    only if they are declared here. ``protocols``:
     the view protocols it runs on (``dataset.core.protocols``). ``resources``:
     ``"gpu"`` if it needs one. ``config_type``: a frozen dataclass whose default
     instance is the config it runs with (its fields go into the result's
@@ -48,6 +69,14 @@ class Method:
     depend on, besides ``dataset`` (a change there recomputes its results);
     ``libraries``: distributions whose versions matter. ``has_footprint``:
     whether it estimates a footprint (it is then listed in Table 3).
+
+    Its config on a command line: ``options``, the flags that set its config's
+    fields (:class:`~dataset.core.method_options.Option`; any field is also set with
+    ``--set NAME.KEY=VALUE``); ``short_run``, field values of a short run (the
+    comparison's built-in default run and its robustness study), under the ones a
+    user gives; ``check_config(config, runs_here)``: raises ``ValueError`` when the
+    config cannot run (``runs_here``: it is about to run in this process, so e.g. its
+    device must exist here).
 
     Optional, for methods that need more: ``record_config(config)``: the config
     as its results record it (default: the dataclass's fields);
@@ -78,6 +107,9 @@ class Method:
     mesh_file: str | None = None
     heavy: bool = False
     debug_images: Callable[..., None] | None = None
+    options: tuple[Option, ...] = ()
+    short_run: Mapping[str, Any] = field(default_factory=dict, hash=False)
+    check_config: Callable[[Any, bool], None] | None = None
 
     def config_record(self, config: Any) -> dict[str, Any]:
         """``config`` as this method's results record it."""
@@ -98,6 +130,31 @@ class Method:
             raise ValueError(f"method {self.name} runs on no protocol")
         if self.mesh_file is not None and self.artefacts is None:
             raise ValueError(f"method {self.name}: a mesh_file needs an artefacts folder")
+        for key in (*(o.key for o in self.options), *self.short_run):
+            try:
+                field_type(self.config_type, key)
+            except ValueError as exc:
+                raise ValueError(f"method {self.name}: option or short-run setting {key!r}: "
+                                 f"{exc}") from exc
+
+
+def built_in_method(name: str) -> Method:
+    """The built-in method ``name`` (imports its package; may raise ``ImportError``)."""
+    module, attribute = BUILT_IN[name].split(":")
+    return getattr(importlib.import_module(module), attribute)
+
+
+def available_methods(warn: Callable[[str], None] | None = None) -> dict[str, Method]:
+    """The built-in methods whose packages import, then the installed plugins, by name."""
+    found: dict[str, Method] = {}
+    for name in BUILT_IN:
+        try:
+            found[name] = built_in_method(name)
+        except ImportError:  # the comparison reports it when the method is asked for
+            continue
+    for name, method in installed_methods(warn).items():
+        found.setdefault(name, method)
+    return found
 
 
 def installed_methods(warn: Callable[[str], None] | None = None) -> dict[str, Method]:

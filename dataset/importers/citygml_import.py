@@ -21,15 +21,20 @@ areas and WWR are sums over them). The others (backyard walls, party walls) stay
 mesh as wall without a facade id and are listed in ``extra["uncovered_facades"]``. The
 ``dataAvailable`` attribute (Sufficient / NotSufficient) is recorded, not used.
 
-**Orientation.** ``extra["facades"][id]["azimuth_deg"]``: the outward normal's azimuth,
-degrees clockwise from the CRS's grid north (+y; for EPSG:32632 UTM grid north, within
-about 1 degree of true north in Ingolstadt).
+**Orientation.** World +y is the CRS's grid north; the truth's ``north_deg`` is the meridian
+convergence at the building (:mod:`dataset.importers.grid_north`, ``north_source``
+``"crs_convergence"``: 1.8 degrees for EPSG:32632 in Ingolstadt), so each facade's
+``azimuth_deg`` is from true north.
+
+**Seen straight on.** Each facade's ``visible_*_area_m2`` is its area less what other
+surfaces of the building (balconies, bays, roof overhangs) hide from the front
+(:mod:`dataset.importers.citygml_visible`).
 """
 
 from __future__ import annotations
 
-import re
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import asdict, replace
 from pathlib import Path
 
@@ -37,36 +42,28 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from dataset.core.appearance import concatenate_appearances
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
 from dataset.core.mesh import LabelledMesh
+from dataset.core.orientation import azimuth_deg_from_normal
 from dataset.core.truth import Building, BuildingTruth, FacadeTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
-from dataset.importers.citygml_config import CityGmlConfig
-from dataset.importers.citygml_facades import FacadeRegions, Surface, building_facades
-from dataset.importers.citygml_polygons import triangulate_polygon
-from dataset.importers.citygml_read import (
-    CityBuilding,
-    CityGmlError,
-    CityModel,
-    citygml_stem,
-    read_citygml,
+from dataset.core.wwr import ClassAreas
+from dataset.importers.citygml_appearance import face_appearance
+from dataset.importers.citygml_buildings import (
+    LABEL_OF_KIND,
+    benchmark_buildings,
+    building_surfaces,
 )
+from dataset.importers.citygml_config import CityGmlConfig
+from dataset.importers.citygml_context import party_wall_area_m2, read_neighbours
+from dataset.importers.citygml_facades import FacadeRegions, Surface, building_facades
+from dataset.importers.citygml_files import CityGmlError
+from dataset.importers.citygml_read import CityBuilding, CityModel, read_citygml
+from dataset.importers.citygml_type import citygml_building_type
+from dataset.importers.citygml_visible import hidden_share, with_visible_areas
+from dataset.importers.grid_north import grid_north_deg
 
-_SAFE = re.compile(r"[^A-Za-z0-9_.-]")
-LABEL_OF_KIND: dict[str, SemanticClass | None] = {
-    "wall": SemanticClass.WALL,
-    "roof": SemanticClass.ROOF,
-    "window": SemanticClass.WINDOW,
-    "door": SemanticClass.DOOR,
-    "installation": SemanticClass.OTHER,
-    "ground": SemanticClass.OTHER,
-    "outer_floor": SemanticClass.OTHER,
-    "outer_ceiling": SemanticClass.OTHER,
-    "closure": None,  # virtual surfaces close open parts of a model: nothing to see
-    "interior": None,  # LoD4 rooms: never seen from outside
-}
-"""Class of each surface kind in the mesh; None: left out of the mesh."""
 WALL_SECTION_M = 0.3
 """Without a ground surface the footprint is what the walls enclose this high above the
 lowest wall point: above a street's slope (up to ~0.2 m across a house here), below most
@@ -77,7 +74,8 @@ _ENCLOSING = ("wall", "roof", "ground", "closure", "outer_floor", "outer_ceiling
 def import_citygml(path: str | Path, *, config: CityGmlConfig | None = None
                    ) -> list[Building]:
     """Every building of a CityGML 2.0/3.0 file with ground truth (one per ``Building`` and
-    ``BuildingPart``; a ``Building`` whose geometry is all in its parts gives none itself).
+    ``BuildingPart``; a ``Building`` whose geometry is all in its parts gives none itself),
+    each with the file's other buildings as its neighbours.
 
     Raises
     ------
@@ -86,14 +84,16 @@ def import_citygml(path: str | Path, *, config: CityGmlConfig | None = None
         surface (named by its ``gml:id``).
     """
     config = CityGmlConfig() if config is None else config
-    return [building_from_citygml(model, b, config=config)
+    return [building_from_citygml(model, b, config=config, neighbour_files=(path,))
             for model in [read_citygml(path)] for b in benchmark_buildings(model)]
 
 
 def import_citygml_building(path: str | Path, name: str, *,
+                            neighbour_files: Sequence[str | Path] | None = None,
                             config: CityGmlConfig | None = None) -> Building:
-    """The building of ``path`` whose scene name is ``name`` (:func:`benchmark_buildings`):
-    what a resumable run re-imports in a worker for one scene.
+    """The building of ``path`` whose scene name is ``name`` (:func:`benchmark_buildings`),
+    its neighbours read from ``neighbour_files`` (default: ``path`` alone): what a
+    resumable run re-imports in a worker for one scene.
 
     Raises
     ------
@@ -102,47 +102,19 @@ def import_citygml_building(path: str | Path, name: str, *,
     """
     config = CityGmlConfig() if config is None else config
     model = read_citygml(path)
+    files = (path,) if neighbour_files is None else tuple(neighbour_files)
     for b in benchmark_buildings(model):
         if b.gml_id == name:
-            return building_from_citygml(model, b, config=config)
+            return building_from_citygml(model, b, config=config, neighbour_files=files)
     raise CityGmlError(f"{path} holds no building {name!r}")
 
 
-def benchmark_buildings(model: CityModel) -> list[CityBuilding]:
-    """The buildings of ``model`` that become scenes, their ids made scene names.
-
-    A ``BuildingPart`` without a wall (a stair, a canopy written as a part) joins its
-    building as what it is (installations stay "other"), with a warning; a ``Building``
-    whose polygons are all in its parts gives no scene itself. A file with one building
-    names it after the file (``4018259.xml`` -> ``4018259``); otherwise the ``gml:id``
-    (characters other than letters, digits, ``_.-`` become ``_``) names it.
-    """
-    by_id = {b.gml_id: b for b in model.buildings}
-    joined: dict[str, list[CityBuilding]] = {}
-    kept = []
-    for b in model.buildings:
-        has_wall = any(p.kind == "wall" for p in b.polygons)
-        if b.is_part and not has_wall and b.parent_id in by_id:
-            joined.setdefault(b.parent_id, []).append(b)
-        elif b.polygons or not b.is_part and not any(
-                c.parent_id == b.gml_id for c in model.buildings):
-            kept.append(b)
-    out = []
-    for b in kept:
-        parts = joined.get(b.gml_id, [])
-        name = _SAFE.sub("_", citygml_stem(model.path) if len(kept) == 1 else b.gml_id)
-        out.append(replace(
-            b, gml_id=name if name[:1].isalnum() else f"b{name}",
-            polygons=b.polygons + tuple(p for c in parts for p in c.polygons),
-            attributes={**b.attributes, "gml:id": b.gml_id},
-            warnings=b.warnings + tuple(f"part {c.gml_id}: no WallSurface, joined to its "
-                                        "building" for c in parts)))
-    return out
-
-
 def building_from_citygml(model: CityModel, building: CityBuilding, *,
-                          config: CityGmlConfig | None = None) -> Building:
-    """One building's labelled mesh and truth (ids of the facades the data covers, from 1).
+                          config: CityGmlConfig | None = None,
+                          neighbour_files: Sequence[str | Path] = ()) -> Building:
+    """One building's labelled mesh and truth (ids of the facades the data covers, from 1),
+    with its appearance and, as its context, every other building of ``neighbour_files``
+    (:mod:`dataset.importers.citygml_context`).
 
     Raises
     ------
@@ -152,19 +124,11 @@ def building_from_citygml(model: CityModel, building: CityBuilding, *,
     config = CityGmlConfig() if config is None else config
     where = f"{model.path}: building {building.attributes.get('gml:id', building.gml_id)}"
     warnings: Counter[str] = Counter(_warning_kind(w) for w in building.warnings)
-    surfaces = []
-    for p in building.polygons:
-        tri = triangulate_polygon(p.rings_m)
-        if tri is None:
-            warnings["polygon without area dropped"] += 1
-            continue
-        warnings["non-planar polygon (> 1 cm), triangulated as it stands"] += tri.non_planar
-        warnings["self-intersecting polygon, made valid"] += tri.repaired
-        surfaces.append(Surface(p.polygon_id, p.kind, p.owner_id, p.rings_m, tri))
+    surfaces = building_surfaces(building, warnings)
     if not any(s.kind == "wall" for s in surfaces):
         raise CityGmlError(f"{where} has no WallSurface polygon with an area; a benchmark "
                            "building needs its walls (LoD2 or LoD3 boundary surfaces)")
-    offset, ground_z = _offset(surfaces, config, warnings)
+    offset, ground_z, centre_xy = _offset(surfaces, config, warnings)
     surfaces = [_moved(s, offset) for s in surfaces]
     if _enclosed_volume_m3(surfaces) < 0:
         surfaces = [_flipped(s) for s in surfaces]
@@ -173,20 +137,29 @@ def building_from_citygml(model: CityModel, building: CityBuilding, *,
     covered = [k for k, f in enumerate(facades) if f.window.area + f.door.area > 0]
     facade_id = {k: i + 1 for i, k in enumerate(covered)}
     mesh = _mesh(surfaces, facades, opening_facade, facade_id)
-    truths = tuple(_facade_truth(facade_id[k], facades[k]) for k in covered)
-    window, wall, door = (sum(getattr(f, a) for f in truths)
-                          for a in ("window_area_m2", "wall_area_m2", "door_area_m2"))
+    appearance = _appearance(model, building, surfaces, len(mesh.faces), offset, warnings)
+    regions = {facade_id[k]: facades[k] for k in covered}
+    truths = with_visible_areas(
+        tuple(_facade_truth(facade_id[k], facades[k]) for k in covered), mesh, regions)
+    totals = ClassAreas(*(sum(getattr(f, a) for f in truths)
+                          for a in ("window_area_m2", "wall_area_m2", "door_area_m2")))
     footprint = _footprint(surfaces, mesh, warnings, where)
+    context = read_neighbours(model, building.gml_id, [Path(f) for f in neighbour_files],
+                              offset)
+    party_m2 = party_wall_area_m2(surfaces, context)
+    front_share = hidden_share(truths, mesh, regions, SemanticClass.OTHER)
     height = float(mesh.vertices_m[:, 2].max())
+    north_deg = grid_north_deg(model.crs, *centre_xy)
     truth = BuildingTruth(
-        id=building.gml_id, type="imported",
+        id=building.gml_id, type=citygml_building_type(front_share, party_m2),
         floors=max(1, round(height / config.floor_height_m)), height_m=height,
-        window_area_m2=window, facade_area_m2=gross_facade_area_m2(wall, window, door),
-        wall_area_m2=wall, door_area_m2=door, wwr=wwr_from_areas(window, wall, door),
+        window_area_m2=totals.window_m2, facade_area_m2=totals.gross_m2,
+        wall_area_m2=totals.wall_m2, door_area_m2=totals.door_m2, wwr=totals.wwr,
         footprint=polygon_to_geojson(footprint), footprint_area_m2=float(footprint.area),
         facades=truths, name=f"{model.path.name}#{building.gml_id}",
         facade_outlines_m={facade_id[k]: (tuple(map(tuple, facades[k].outline_m())),)
                            for k in covered},
+        north_deg=north_deg, north_source="crs_convergence",
         extra={
             "source_file": model.path.name,
             "citygml_version": model.version,
@@ -199,23 +172,21 @@ def building_from_citygml(model: CityModel, building: CityBuilding, *,
             "data_available": building.attributes.get("dataAvailable", ""),
             "facades": {str(facade_id[k]): _facade_record(facades[k], surfaces)
                         for k in covered},
-            "uncovered_facades": [_uncovered_record(f, surfaces) for k, f in enumerate(facades)
-                                  if k not in facade_id],
+            "uncovered_facades": [_uncovered_record(f, surfaces, north_deg)
+                                  for k, f in enumerate(facades) if k not in facade_id],
             "unassigned_openings": sorted(o for o in {s.owner_id for s in surfaces
                                                       if s.kind in ("window", "door")}
                                           if o not in opening_facade),
             "opening_fill_area_m2": float(sum(_fill_area(facades[k]) for k in covered)),
+            "neighbours": [n.name for n in context],
+            "party_wall_area_m2": party_m2,
+            "front_hidden_share": front_share,
             "counts": dict(sorted(Counter(s.kind for s in surfaces).items())),
             "warnings": dict(sorted((k, v) for k, v in warnings.items() if v)),
             "import_config": asdict(config),
         },
     )
-    return Building(mesh=mesh, truth=truth)
-
-
-def azimuth_deg(normal: np.ndarray) -> float:
-    """Azimuth of a horizontal direction, degrees clockwise from +y (grid north), in [0, 360)."""
-    return float(np.degrees(np.arctan2(normal[0], normal[1])) % 360.0)
+    return Building(mesh=mesh, truth=truth, appearance=appearance, context=context)
 
 
 def _warning_kind(message: str) -> str:
@@ -223,19 +194,21 @@ def _warning_kind(message: str) -> str:
 
 
 def _offset(surfaces: list[Surface], config: CityGmlConfig, warnings: Counter
-            ) -> tuple[np.ndarray, float]:
+            ) -> tuple[np.ndarray, float, tuple[float, float]]:
     """The shift (3,) that puts the lowest ground-surface point at z = 0 and the ground
-    surface's x/y bounding-box centre at the origin (walls without a ground surface)."""
+    surface's x/y bounding-box centre at the origin (walls without a ground surface), that
+    lowest z and that centre (file CRS, metres)."""
     ground = [s.tri.vertices_m for s in surfaces if s.kind == "ground"]
     if not ground:
         warnings["no GroundSurface: ground at the lowest wall point"] += 1
         ground = [s.tri.vertices_m for s in surfaces if s.kind == "wall"]
     pts = np.concatenate(ground)
     ground_z = float(pts[:, 2].min())
-    if not config.recentre:
-        return np.array([0.0, 0.0, -ground_z]), ground_z
     lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
-    return -np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, ground_z]), ground_z
+    centre = (float(lo[0] + hi[0]) / 2, float(lo[1] + hi[1]) / 2)
+    if not config.recentre:
+        return np.array([0.0, 0.0, -ground_z]), ground_z, centre
+    return -np.array([centre[0], centre[1], ground_z]), ground_z, centre
 
 
 def _moved(s: Surface, offset: np.ndarray) -> Surface:
@@ -287,25 +260,38 @@ def _mesh(surfaces: list[Surface], facades: list[FacadeRegions], opening_facade:
                         np.concatenate(labels), np.concatenate(fids))
 
 
+def _appearance(model: CityModel, building: CityBuilding, surfaces: list[Surface],
+                faces: int, offset: np.ndarray, warnings: Counter):
+    """The mesh faces' textures and colours: the surfaces' (in :func:`_mesh`'s order), then
+    none for the fillers."""
+    by_id = {p.polygon_id: p for p in building.polygons}
+    shown = [by_id[s.polygon_id] for s in surfaces if LABEL_OF_KIND[s.kind] is not None]
+    counts = [len(s.tri.faces) for s in surfaces if LABEL_OF_KIND[s.kind] is not None]
+    appearance = face_appearance(
+        [model.looks.get(p.polygon_id) for p in shown], [(p.ring_ids, p.rings_m) for p in shown],
+        [p.reversed for p in shown], counts, offset, model.path.parent, warnings)
+    return concatenate_appearances([(appearance, sum(counts)), (None, faces - sum(counts))])
+
+
 def _facade_truth(fid: int, f: FacadeRegions) -> FacadeTruth:
-    window, door, wall = float(f.window.area), float(f.door.area), float(f.wall.area)
+    areas = ClassAreas(float(f.window.area), float(f.wall.area), float(f.door.area))
     u0, v0, u1, v1 = f.gross.bounds
     return FacadeTruth(
         id=fid, normal=tuple(float(x) for x in f.normal), width_m=float(u1 - u0),
-        height_m=float(v1 - v0), window_area_m2=window, wall_area_m2=wall, door_area_m2=door,
-        facade_area_m2=gross_facade_area_m2(wall, window, door),
-        wwr=wwr_from_areas(window, wall, door))
+        height_m=float(v1 - v0), window_area_m2=areas.window_m2, wall_area_m2=areas.wall_m2,
+        door_area_m2=areas.door_m2, facade_area_m2=areas.gross_m2, wwr=areas.wwr)
 
 
 def _facade_record(f: FacadeRegions, surfaces: list[Surface]) -> dict:
-    """Identity and orientation of a covered facade (its wall polygons and openings)."""
-    return {"azimuth_deg": azimuth_deg(f.normal),
-            "wall_polygon_ids": [surfaces[i].polygon_id for i in f.surfaces],
+    """Identity of a covered facade: its wall polygons and openings (its orientation is the
+    truth's ``azimuth_deg``)."""
+    return {"wall_polygon_ids": [surfaces[i].polygon_id for i in f.surfaces],
             "opening_ids": list(f.openings)}
 
 
-def _uncovered_record(f: FacadeRegions, surfaces: list[Surface]) -> dict:
-    return {"azimuth_deg": azimuth_deg(f.normal), "normal": [float(x) for x in f.normal],
+def _uncovered_record(f: FacadeRegions, surfaces: list[Surface], north_deg: float) -> dict:
+    return {"azimuth_deg": azimuth_deg_from_normal(f.normal, north_deg),
+            "normal": [float(x) for x in f.normal],
             "wall_area_m2": float(f.wall.area), "width_m": float(f.gross.bounds[2]
                                                                   - f.gross.bounds[0]),
             "wall_polygon_ids": [surfaces[i].polygon_id for i in f.surfaces]}

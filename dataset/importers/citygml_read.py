@@ -16,8 +16,6 @@ Errors name the file and the element's ``gml:id`` (:class:`CityGmlError`).
 
 from __future__ import annotations
 
-import bz2
-import gzip
 import lzma
 import re
 from dataclasses import dataclass, field
@@ -25,6 +23,13 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
+
+from dataset.importers.citygml_appearance import PolygonLook, polygon_looks
+from dataset.importers.citygml_files import (
+    CITYGML_NAMESPACES,
+    CityGmlError,
+    open_citygml,
+)
 
 SurfaceKind = Literal["wall", "roof", "ground", "closure", "outer_floor", "outer_ceiling",
                       "window", "door", "installation", "interior"]
@@ -51,18 +56,12 @@ SURFACE_KINDS: dict[str, SurfaceKind] = {
 """Local element name -> what its polygons are (2.0 and 3.0 names)."""
 OPENING_KINDS: tuple[SurfaceKind, ...] = ("window", "door")
 BUILDING_TAGS = ("Building", "BuildingPart")
-CITYGML_VERSIONS = {"http://www.opengis.net/citygml/2.0": "2.0",
-                    "http://www.opengis.net/citygml/3.0": "3.0"}
+CITYGML_VERSIONS = dict(zip(CITYGML_NAMESPACES, ("2.0", "3.0")))
 GEOGRAPHIC_EPSG = frozenset({4326, 4258, 4269, 4937, 4979, 4978, 4289, 4167})
 """EPSG codes in degrees (or geocentric): refused, the importer needs metres."""
 _ADV_CRS = {"ETRS89_UTM32": 25832, "ETRS89_UTM33": 25833}  # German AdV names (urn:adv:crs:...)
-_OPENERS = {".gz": gzip.open, ".xz": lzma.open, ".bz2": bz2.open}
 _XLINK_HREF = "{http://www.w3.org/1999/xlink}href"
 _EPSG_PATTERNS = (re.compile(r"EPSG:{1,2}(\d+)", re.I), re.compile(r"/EPSG/\d+/(\d+)", re.I))
-
-
-class CityGmlError(ValueError):
-    """Bad CityGML input; the message names the file and the element's ``gml:id``."""
 
 
 @dataclass(frozen=True)
@@ -73,13 +72,17 @@ class CityPolygon:
     repeated closing point. ``owner_id``: the ``gml:id`` of the element it belongs to (the
     window, door or installation for those; the boundary surface's id, or the building's
     id when the surface has none). ``polygon_id``: the polygon's own ``gml:id``
-    (``"<owner_id>#<k>"`` when it has none).
+    (``"<owner_id>#<k>"`` when it has none). ``ring_ids``: each ring's ``gml:id`` (``""``
+    when it has none), what texture coordinates name; ``reversed``: the rings are the file's
+    in reverse order (an ``OrientableSurface orientation="-"``).
     """
 
     polygon_id: str
     kind: SurfaceKind
     owner_id: str
     rings_m: tuple[np.ndarray, ...]
+    ring_ids: tuple[str, ...] = ()
+    reversed: bool = False
 
 
 @dataclass(frozen=True)
@@ -104,12 +107,14 @@ class CityBuilding:
 @dataclass(frozen=True)
 class CityModel:
     """What :func:`read_citygml` found: version (``"2.0"``/``"3.0"``), CRS as ``EPSG:<code>``,
-    and the buildings in file order."""
+    the buildings in file order, and the polygons' looks (polygon ``gml:id`` ->
+    :class:`dataset.importers.citygml_appearance.PolygonLook`)."""
 
     path: Path
     version: str
     crs: str
     buildings: tuple[CityBuilding, ...]
+    looks: dict[str, PolygonLook] = field(default_factory=dict)
 
 
 def read_citygml(path: str | Path) -> CityModel:
@@ -131,9 +136,8 @@ def read_citygml(path: str | Path) -> CityModel:
     path = Path(path)
     if not path.is_file():
         raise CityGmlError(f"CityGML file {path} does not exist")
-    opener = _OPENERS.get(path.suffix.lower(), open)
     try:
-        with opener(path, "rb") as fh:
+        with open_citygml(path) as fh:
             tree = etree.parse(fh, etree.XMLParser(huge_tree=True, resolve_entities=False))
     except (etree.XMLSyntaxError, EOFError, OSError, lzma.LZMAError) as exc:
         raise CityGmlError(
@@ -162,42 +166,8 @@ def read_citygml(path: str | Path) -> CityModel:
             parent_id=None if parent is None else _gml_id(parent)))
     if not buildings:
         raise CityGmlError(f"{path} holds no Building or BuildingPart element")
-    return CityModel(path, version, _crs(path, root, buildings[0].gml_id), tuple(buildings))
-
-
-def citygml_files(path: str | Path) -> list[Path]:
-    """The CityGML files ``path`` names: itself, or every ``.gml``/``.xml`` file below a folder
-    (also compressed: ``.gz``, ``.xz``, ``.bz2``), sorted.
-
-    Raises
-    ------
-    CityGmlError
-        ``path`` does not exist or the folder holds no such file.
-    """
-    path = Path(path)
-    if path.is_file():
-        return [path]
-    if not path.is_dir():
-        raise CityGmlError(f"{path} does not exist; give a CityGML file or a folder of them")
-    files = sorted(p for p in path.rglob("*") if p.is_file() and _stem_suffix(p)[1])
-    if not files:
-        raise CityGmlError(f"{path} holds no .gml or .xml file (plain, .gz, .xz or .bz2)")
-    return files
-
-
-def citygml_stem(path: str | Path) -> str:
-    """A CityGML file's name without its suffixes: ``4018259.xml.xz`` -> ``4018259``."""
-    return _stem_suffix(Path(path))[0]
-
-
-def _stem_suffix(path: Path) -> tuple[str, str]:
-    name = path.name
-    low = name.lower()
-    for comp in ("", *_OPENERS):
-        for ext in (".gml", ".xml"):
-            if low.endswith(ext + comp):
-                return name[: len(name) - len(ext + comp)], ext + comp
-    return path.stem, ""
+    return CityModel(path, version, _crs(path, root, buildings[0].gml_id), tuple(buildings),
+                     polygon_looks(root))
 
 
 def _gml_id(el) -> str | None:
@@ -240,7 +210,8 @@ def _building_polygons(path: Path, building, building_id: str, by_id: dict,
         if polygon_id in seen:
             continue
         seen.add(polygon_id)
-        rings = [_ring_points(path, r, polygon_id) for r in _rings(polygon)]
+        ring_els = _rings(polygon)
+        rings = [_ring_points(path, r, polygon_id) for r in ring_els]
         if not rings:
             raise CityGmlError(f"{path}: polygon {polygon_id} has no exterior ring")
         if rings[0] is None:
@@ -250,8 +221,9 @@ def _building_polygons(path: Path, building, building_id: str, by_id: dict,
         if any(r is None for r in rings[1:]):
             warnings.append(f"polygon {polygon_id}: hole of fewer than three distinct points "
                             "(no area), hole dropped")
+        ring_ids = tuple(_gml_id(e) or "" for e, r in zip(ring_els, rings) if r is not None)
         rings = tuple(r[::-1] if reverse else r for r in rings if r is not None)
-        yield CityPolygon(polygon_id, kind, owner_id, rings)
+        yield CityPolygon(polygon_id, kind, owner_id, rings, ring_ids, reverse)
 
 
 def _polygon_sources(path: Path, building, building_id: str, by_id: dict):
