@@ -141,3 +141,21 @@ def test_real_street_neighbours_and_types():
         assert b.context and all(len(n.mesh.faces) for n in b.context)
     assert types == {"4018207": "terraced", "4018149b": "with_balconies",
                      "4018133": "detached"}
+
+
+def test_the_source_reads_a_folder_as_one_city_model(tmp_path):
+    """Two files 20 m apart and one 200 m away: each entry's building has the buildings of
+    the files within 30 m as neighbours, and its inputs fingerprint those files."""
+    from dataset.importers.citygml_source import CITYGML_SOURCE
+    from dataset.importers.source import NoOptions
+
+    write_boxes(tmp_path / "a.gml", [A])
+    write_boxes(tmp_path / "b.gml", [Box("F", (30, 40), (0, 10), 8, windows=((32, 1, 34, 3),))])
+    write_boxes(tmp_path / "c.gml", [Box("G", (230, 240), (0, 10), 8, windows=((232, 1, 234, 3),))])
+    assert CITYGML_SOURCE.detect(tmp_path) and CITYGML_SOURCE.detect(tmp_path / "a.gml")
+    entries = {e.name: e for e in CITYGML_SOURCE.read(tmp_path, NoOptions())}
+    assert sorted(entries) == ["a", "b", "c"]  # one building a file: named after the file
+    assert set(entries["a"].inputs) == {"citygml", "building", "neighbours"}
+    assert len(entries["a"].inputs["neighbours"]) == 1 and entries["c"].inputs["neighbours"] == []
+    assert [n.name for n in entries["a"].build().context] == ["b.gml#b"]
+    assert entries["c"].build().context == ()
