@@ -54,7 +54,7 @@ def test_training_refuses_evaluated_buildings(tiny_benchmark):
         load_training_scenes([tiny_benchmark])
 
 
-@pytest.mark.parametrize("preset", ["paper", "heldout"])
+@pytest.mark.parametrize("preset", ["paper", "heldout", "lod3"])
 def test_training_refuses_every_evaluated_preset(clean_scene, tmp_path, preset):
     scene = tmp_path / clean_scene.name
     shutil.copytree(clean_scene, scene)
@@ -67,7 +67,7 @@ def test_training_refuses_every_evaluated_preset(clean_scene, tmp_path, preset):
 
 
 def test_training_buildings_share_no_seed_with_an_evaluated_preset():
-    assert {"paper", "tiny", "heldout"} <= set(EVALUATED_PRESETS)
+    assert {"paper", "tiny", "heldout", "lod3"} <= set(EVALUATED_PRESETS)
     assert TRAINING_PRESET not in EVALUATED_PRESETS
     train = {r.seed for r in preset_recipes(TRAINING_PRESET)}
     assert len(train) == 48

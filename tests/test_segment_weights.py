@@ -13,6 +13,8 @@ from dataset.core.classes import CLASS_NAMES
 from dataset.presets import preset_recipes
 from segment.network import UNet, UNetConfig
 from segment.segmenter import predict_labels
+from segment.train import TrainConfig
+from segment.training_data import EVALUATED_PRESETS
 from segment.weights import DEFAULT_WEIGHTS, WEIGHTS_FORMAT, load_network, save_weights
 
 SMALL = UNetConfig(base_channels=4, levels=3)
@@ -58,12 +60,15 @@ def test_the_committed_weights_load_without_network_and_say_how_they_were_made(m
     assert model.config.num_classes == len(CLASS_NAMES)
     assert record == json.loads(DEFAULT_WEIGHTS.with_suffix(".json").read_text())
     # trained on segtrain buildings only: no building of an evaluated preset, by seed or name
-    evaluated = {(r.family, r.seed) for p in ("paper", "tiny") for r in preset_recipes(p)}
+    evaluated = {(r.family, r.seed) for p in EVALUATED_PRESETS for r in preset_recipes(p)}
     used = record["trained_on"] + record["validated_on"]
     assert used and {s["preset"] for s in used} == {"segtrain"}
     families = {r.id: r.family for r in preset_recipes("segtrain")}
     assert not {(families[s["recipe"]], s["recipe_seed"]) for s in used} & evaluated
     assert record["config"]["seed"] == 0 and record["steps_run"] >= 1
+    # the training default is the run that made them (docs/segment.md repeats it)
+    assert record["config"]["steps"] == record["steps_run"] == TrainConfig().steps
+    assert not record["cut_short"]
     assert set(record["provenance"]["code"]) == {"segment", "dataset"}
     assert record["provenance"]["environment"]["torch"]
 
