@@ -1,9 +1,10 @@
 """Comparisons on a segmenter's masks (``python -m metrics.compare --masks predicted[:MODEL]``).
 
-Every scene is copied once into ``<data>-masks/<key>/<scene>`` with each view's
-semantic image replaced by the segmenter's prediction from its RGB
+Every scene is copied once into ``<data>-masks/<key>/<scene>`` with the semantic image
+of each view the methods read replaced by the segmenter's prediction from its RGB
 (:func:`segment.scene_masks.predicted_scene`: cached by provenance, the truth and
-every other file hard links to the original). The methods run on the copies
+every other file hard links to the original; views no method reads are left out, see
+:func:`splits_read`). The methods run on the copies
 unchanged; their results go to ``<results>/masks/<key>`` and carry the segmenter in
 their config under ``masks``; the truth stays the exact one. The usual comparison on
 the exact masks runs too (reusing its stored results), and ``<out>-masks-<key>``
@@ -23,6 +24,7 @@ import numpy as np
 from tqdm import tqdm
 
 from dataset.core.classes import SemanticClass
+from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from dataset.scenes.scene import read_scene
 from metrics.aggregate import summarise
 from metrics.errors import BuildingErrors
@@ -94,8 +96,21 @@ class PredictedRun:
     segmenter: Segmenter
 
 
-def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter) -> PredictedRun:
-    """Make (or reuse) the mask copy of every scene of ``data`` and name the folders.
+def splits_read(specs: Sequence[MethodSpec]) -> tuple[str, ...]:
+    """The frame splits the methods read: their protocols (``ideal``, ``multi``: the
+    facade views of the 2D methods; ``train``: the orbit views), and with ``train`` the
+    held-out ``eval`` orbit views a trained method renders for its own checks. Only these
+    are segmented: the 2D methods read 36 of a paper scene's 236 frames."""
+    splits = {p for s in specs for p in s.protocols}
+    if TRAIN_PROTOCOL in splits:
+        splits.add(EVAL_SPLIT)
+    return tuple(sorted(splits))
+
+
+def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter,
+                  splits: Sequence[str] | None = None) -> PredictedRun:
+    """Make (or reuse) the mask copy of every scene of ``data`` (of the frames of
+    ``splits``; ``None``: every frame) and name the folders.
 
     Raises
     ------
@@ -106,7 +121,7 @@ def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter) ->
     cache = data.with_name(f"{data.name}-masks") / key
     scenes = [d for d in find_scenes(data) if (d / "transforms.json").is_file()]
     for scene_dir in tqdm(scenes, desc=f"masks {key}", unit="scene", leave=False):
-        predicted_scene(scene_dir, cache, segmenter)
+        predicted_scene(scene_dir, cache, segmenter, splits=splits)
     return PredictedRun(cache, results / "masks" / key, out.with_name(f"{out.name}-masks-{key}"),
                         segmenter)
 
@@ -132,8 +147,9 @@ def compare_on_predicted_masks(
     """Compare on exact masks and on ``segmenter``'s; write the table :data:`TABLE_NAME`
     into the predicted run's ``out`` and return it with the run's folders (``options``
     go to ``compare``; ``specs_for(results folder)`` makes the methods' specs)."""
-    exact = compare(data, specs_for(results), results, out, command=command, **options)
-    run = predicted_run(data, results, out, segmenter)
+    specs = specs_for(results)
+    exact = compare(data, specs, results, out, command=command, **options)
+    run = predicted_run(data, results, out, segmenter, splits_read(specs))
     predicted = compare(run.data, with_predicted_masks(specs_for(run.results), segmenter),
                         run.results, run.out, command=command, **options)
     exact_dirs = {d.name: d for d in find_scenes(data)}
@@ -174,7 +190,8 @@ def exact_vs_predicted_table(exact: Sequence[BuildingErrors], predicted: Sequenc
               "facade_ape_exact", "facade_ape_predicted"),
         rows=tuple(rows),
         notes=(f"window IoU of the {segmenter} segmenter against the exact masks, pooled over "
-               f"each building's views (class {int(SemanticClass.WINDOW)}, window)",),
+               f"the views of each building that the methods read (class "
+               f"{int(SemanticClass.WINDOW)}, window)",),
     )
 
 

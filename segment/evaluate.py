@@ -101,11 +101,14 @@ def segmenter_scene_iou(scene: Scene, segmenter: Segmenter,
 
 
 def masks_scene_iou(exact: Scene, predicted: Scene) -> SceneIou:
-    """IoU of a mask copy's semantic images against the exact scene's (same frames)."""
+    """IoU of a mask copy's semantic images against the exact scene's, over the copy's
+    frames (matched by image path; a copy may hold only some of the scene's frames)."""
     confusion = np.zeros((NUM_CLASSES, NUM_CLASSES), np.int64)
     count = 0
-    for fe, fp in zip(exact.frames, predicted.frames, strict=True):
-        if fe.semantic_file_path is None or fp.semantic_file_path is None:
+    exact_frames = {f.file_path: f for f in exact.frames}
+    for fp in predicted.frames:
+        fe = exact_frames.get(fp.file_path)
+        if fe is None or fe.semantic_file_path is None or fp.semantic_file_path is None:
             continue
         confusion += confusion_matrix(read_frame_labels(predicted, fp),
                                       read_frame_labels(exact, fe))

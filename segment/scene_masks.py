@@ -3,8 +3,11 @@
 Every frame's semantic image is replaced by ``segmenter(rgb)`` (a frame without one
 gets ``semantics/<image name>.png``); every other file, the truth included, is a hard
 link to the original (:func:`dataset.degrade.scene_copy.link_tree`), so the source is
-never modified. The segmenter reads the RGB images and nothing else: not the exact
-masks, not ``building.json``, ``mesh.ply`` or ``instances/``.
+never modified. Given ``splits``, only the frames of those splits are segmented and
+kept: the others leave the copy's ``transforms.json`` and their exact semantic and
+instance images leave the copy (no exact mask is left for a method to find).
+The segmenter reads the RGB images and nothing else: not the exact masks, not
+``building.json``, ``mesh.ply`` or ``instances/``.
 
 The copy's ``transforms.json`` records, under :data:`RECORD_KEY`, the provenance of its
 masks: the segmenter's name and identity (weights and code fingerprints, or a plugin's
@@ -16,6 +19,7 @@ atomically, so a refused prediction (wrong shape, dtype, class ids) leaves nothi
 from __future__ import annotations
 
 import json
+from collections.abc import Collection
 from dataclasses import replace
 from pathlib import Path
 
@@ -50,11 +54,14 @@ def scene_folders(folder: str | Path) -> list[Path]:
     return sorted(d for d in folder.iterdir() if (d / "transforms.json").is_file())
 
 
-def masks_provenance(segmenter: Segmenter, source_dir: str | Path) -> Provenance:
-    """The record a mask copy of ``source_dir`` made by ``segmenter`` carries."""
+def masks_provenance(segmenter: Segmenter, source_dir: str | Path,
+                     splits: Collection[str] | None = None) -> Provenance:
+    """The record a mask copy of ``source_dir`` made by ``segmenter`` carries (``splits``:
+    the frame splits it holds, ``None``: every frame)."""
     transforms = Path(source_dir) / "transforms.json"
     return make_provenance(
-        {"segmenter": segmenter.name, **segmenter.identity},
+        {"segmenter": segmenter.name, **segmenter.identity,
+         "splits": "all" if splits is None else sorted(set(splits))},
         modules=("segment.scene_masks",),
         inputs={"scene": file_fingerprint(transforms) if transforms.is_file() else "absent"},
         libraries=("numpy", "opencv-contrib-python-headless"),
@@ -62,10 +69,12 @@ def masks_provenance(segmenter: Segmenter, source_dir: str | Path) -> Provenance
 
 
 def predicted_scene(source_dir: str | Path, out_root: str | Path, segmenter: Segmenter, *,
-                    progress: bool = True) -> Path:
+                    splits: Collection[str] | None = None, progress: bool = True) -> Path:
     """Write ``out_root / <scene name>``: the scene with the segmenter's masks; return it.
 
-    A finished copy with the same provenance is reused.
+    ``splits``: segment and keep only the frames of these splits (``"ideal"``,
+    ``"multi"``, ``"train"``, ``"eval"``; ``None``: every frame). A finished copy with the
+    same provenance (segmenter, source, splits) is reused.
 
     Raises
     ------
@@ -76,15 +85,21 @@ def predicted_scene(source_dir: str | Path, out_root: str | Path, segmenter: Seg
     """
     source_dir = Path(source_dir)
     source = read_scene(source_dir)
-    record = masks_provenance(segmenter, source_dir)
+    record = masks_provenance(segmenter, source_dir, splits)
     out = Path(out_root) / source_dir.name
     if stored_masks_changes(out, record) == []:
         return out
+    kept = [fr for fr in source.frames if splits is None or fr.split in splits]
     with atomic_directory(out) as tmp:
         link_tree(source_dir, tmp)
+        for fr in source.frames:
+            if splits is not None and fr.split not in splits:
+                for rel in (fr.semantic_file_path, fr.instance_file_path):
+                    if rel is not None:
+                        (tmp / rel).unlink(missing_ok=True)
         frames = tuple(
             _predict_frame(source.root, tmp, fr, segmenter)
-            for fr in tqdm(source.frames, desc=f"masks {source_dir.name}", unit="frame",
+            for fr in tqdm(kept, desc=f"masks {source_dir.name}", unit="frame",
                            leave=False, disable=not progress))
         extra = {**source.extra, RECORD_KEY: record.to_json_dict()}
         write_transforms(tmp, replace(source, root=tmp, frames=frames,

@@ -16,7 +16,9 @@ from metrics.predicted_masks import (
     exact_vs_predicted_table,
     masks_key,
     parse_masks,
+    splits_read,
 )
+from metrics.runner import MethodSpec
 from segment.evaluate import SceneIou
 from segment.segmenter import Segmenter
 
@@ -35,6 +37,15 @@ def test_keys_name_the_segmenter_and_its_weights():
     assert masks_key(Segmenter("/x/my weights.pt", len, {"weights": "ab" * 8})) == (
         "predicted-my_weights-abababab")
     assert masks_key(Segmenter("toy-masks", len, {"entry_point": "x"})) == "predicted-toy-masks"
+
+
+def test_only_the_splits_the_methods_read_are_segmented():
+    def spec(*protocols):
+        return MethodSpec("m", protocols, {}, run=len)
+
+    assert splits_read([spec("ideal", "multi")]) == ("ideal", "multi")
+    assert splits_read([spec("ideal"), spec("train")]) == ("eval", "ideal", "train")
+    assert splits_read([]) == ()
 
 
 def _rows(scene, family, wwr, window, facade):

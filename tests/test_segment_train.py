@@ -14,6 +14,7 @@ from dataset.presets import preset_recipes
 from dataset.scenes.images import read_labels, read_rgb, write_labels, write_rgb
 from dataset.scenes.scene import read_scene
 from segment.augment import AugmentConfig
+from segment.evaluate import masks_scene_iou
 from segment.network import UNetConfig
 from segment.scene_masks import RECORD_KEY, predicted_scene
 from segment.segmenter import Segmenter, network_segmenter
@@ -125,6 +126,26 @@ def test_the_segmenter_never_sees_the_truth(trained, clean_scene, tmp_path):
     for fa, fb in zip(read_scene(a).frames, read_scene(b).frames, strict=True):
         assert (read_labels(a / fa.semantic_file_path)
                 == read_labels(b / fb.semantic_file_path)).all()
+
+
+def test_a_copy_of_some_splits_holds_their_frames_and_no_other_exact_mask(clean_scene, tmp_path):
+    source = read_scene(clean_scene)
+    walls = Segmenter("walls", lambda rgb: np.ones(rgb.shape[:2], np.uint8), {})
+    copy = predicted_scene(clean_scene, tmp_path, walls, splits=("ideal",), progress=False)
+    scene = read_scene(copy)
+    ideal = [f.file_path for f in source.frames if f.split == "ideal"]
+    assert ideal and [f.file_path for f in scene.frames] == ideal
+    assert all((read_labels(copy / f.semantic_file_path) == 1).all() for f in scene.frames)
+    for fr in source.frames:  # the exact masks of the frames left out are not in the copy
+        if fr.split != "ideal":
+            assert not (copy / fr.semantic_file_path).exists()
+            assert (copy / fr.file_path).samefile(clean_scene / fr.file_path)
+    record = json.loads((copy / "transforms.json").read_text())[RECORD_KEY]
+    assert record["config"]["splits"] == ["ideal"]
+    # the IoU is over the copy's frames; every frame: the copy is made again
+    assert masks_scene_iou(source, scene).frames == len(ideal)
+    predicted_scene(clean_scene, tmp_path, walls, progress=False)
+    assert len(read_scene(copy).frames) == len(source.frames)
 
 
 @pytest.mark.parametrize("answer", ["shape", "dtype", "ids"])
