@@ -13,10 +13,11 @@ from dataset.core.classes import CLASS_NAMES
 from dataset.presets import preset_recipes
 from dataset.scenes.images import read_labels, read_rgb, write_labels, write_rgb
 from dataset.scenes.scene import read_scene
+from metrics.runner import find_scenes
 from segment.augment import AugmentConfig
 from segment.evaluate import masks_scene_iou
 from segment.network import UNetConfig
-from segment.scene_masks import RECORD_KEY, predicted_scene
+from segment.scene_masks import RECORD_KEY, predicted_scene, scene_folders
 from segment.segmenter import Segmenter, network_segmenter
 from segment.train import TrainConfig, main, train_segmenter
 from segment.training_data import (
@@ -146,6 +147,16 @@ def test_a_copy_of_some_splits_holds_their_frames_and_no_other_exact_mask(clean_
     assert masks_scene_iou(source, scene).frames == len(ideal)
     predicted_scene(clean_scene, tmp_path, walls, progress=False)
     assert len(read_scene(copy).frames) == len(source.frames)
+
+
+def test_a_copy_a_killed_run_left_unfinished_is_no_scene(clean_scene, tmp_path):
+    """A run killed by a signal leaves ``.<scene>.<random>.partial`` (hard links of the
+    source, some masks replaced): it must not be measured as one more building."""
+    data = tmp_path / "masks"
+    zeros = Segmenter("zeros", lambda rgb: np.zeros(rgb.shape[:2], np.uint8), {})
+    done = predicted_scene(clean_scene, data, zeros, progress=False)
+    shutil.copytree(done, data / f".{clean_scene.name}.x1y2.partial")
+    assert find_scenes(data) == scene_folders(data) == [done]
 
 
 @pytest.mark.parametrize("answer", ["shape", "dtype", "ids"])
