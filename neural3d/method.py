@@ -186,5 +186,5 @@ METHOD_NEURAL3D = Method(
                 "measured on its mesh (cpu or gpu: --device)",
     record_config=record_config, reserve=reserve, artefacts=RUNS_FOLDER,
     mesh_file=f"{EXTRACT_FOLDER}/mesh.ply", heavy=True,
-    options=OPTIONS, short_run=SHORT_RUN, check_config=check_budget,
+    options=OPTIONS, short_run=SHORT_RUN, check_config=check_budget, paper_name="BuildNet3D",
 )

@@ -82,15 +82,18 @@ def test_results_of_several_seeds_keep_a_file_each(tmp_path):
 
 
 def test_paper_figures_sit_beside_ours_where_the_paper_has_the_row():
-    assert paper_table2("realistic", "neural3d", "train")["wwr_ape"].mean == 3.5
+    assert paper_table2("realistic", "BuildNet3D", "train")["wwr_ape"].mean == 3.5
     assert paper_table2("l_shaped", "2D-SS", "multi")["facade_ape"].std == 0.5
     assert paper_table2("all", "2D-S", "ideal") is None  # the paper pools no families
-    assert paper_table3("skyscraper", "neural3d", "train").mean == 0.960
+    assert paper_table3("skyscraper", "BuildNet3D", "train").mean == 0.960
+    assert paper_table3("skyscraper", None, "train") is None  # a method the paper has not
     assert paper_table3("skyscraper", "2D-S", "ideal") is None
     rows = [BuildingErrors(s, "realistic", "neural3d", "train", wwr_ape=e, window_ape=e,
                            facade_ape=1.0, footprint_iou=0.97) for s, e in (("a", 2.0), ("b", 4.0))]
     groups = aggregate_by_family(rows)
-    t2, t3 = paper_table2_comparison(groups), paper_table3_comparison(groups)
+    names = {"neural3d": "BuildNet3D"}  # what neural3d's Method.paper_name says
+    t2, t3 = paper_table2_comparison(groups, names), paper_table3_comparison(groups, names)
+    assert paper_table2_comparison(groups, {}).rows == ()  # no method known to the paper
     assert len(t2.rows) == 1 and len(t3.rows) == 1  # the pooled row has no paper figure
     assert format_cell(t2.rows[0][6], 2) == "3.50 ± 2.20"
     assert format_cell(t2.rows[0][5], 2) == "3.00 ± 1.00 [2.00, 4.00]"
@@ -129,7 +132,7 @@ def test_claims_tables_leave_out_tables_without_rows():
 
     rows = [BuildingErrors(s, "l_shaped", "2D-S", "ideal", wwr_ape=e) for s, e in (("a", 1.0),
                                                                                   ("b", 2.0))]
-    names = [t.name for t in claims_tables(aggregate_by_family(rows))]
+    names = [t.name for t in claims_tables(aggregate_by_family(rows), {"2D-S": "2D-S"})]
     assert names == ["table2_visible", "paper_table2"]  # no seeds, no footprint in the paper
 
 
@@ -146,7 +149,10 @@ def test_report_sections_show_the_visible_table_with_its_intervals(tmp_path):
     assert "seed" not in html.lower()  # no seed table written
     from metrics.report import table2_errors, table3_footprint_iou
 
-    t2 = table2_html(read_csv_rows(to_csv(table2_errors(groups))))
+    names = {"neural3d": "BuildNet3D"}
+    paper2 = read_csv_rows(to_csv(paper_table2_comparison(groups, names)))
+    paper3 = read_csv_rows(to_csv(paper_table3_comparison(groups, names)))
+    t2 = table2_html(read_csv_rows(to_csv(table2_errors(groups))), paper2)
     assert "3.00 ± 1.00 [2.00, 4.00]" in t2 and "3.50 ± 2.20" in t2  # ours, then the paper's
-    t3 = table3_html(read_csv_rows(to_csv(table3_footprint_iou(groups, {"neural3d"}))))
+    t3 = table3_html(read_csv_rows(to_csv(table3_footprint_iou(groups, {"neural3d"}))), paper3)
     assert "BuildNet3D paper, Table 3" in t3 and "0.971" in t3
