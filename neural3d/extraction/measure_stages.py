@@ -121,10 +121,13 @@ def cull_hidden_faces(state: MeasureState, config: MeasureConfig) -> MeasureStat
     if state.raycaster is None:
         return state
     facade = state.facade_area_m2 > 0
+    ground_box = np.stack([state.vertices_m[:, :2].min(axis=0),
+                           state.vertices_m[:, :2].max(axis=0)])
     seen = seen_from_outside(state.raycaster, facade,
                              rays_per_sample=config.visibility_rays_per_sample,
                              offset_m=config.ray_offset_m,
-                             min_escape_fraction=config.min_escape_fraction, ground=True)
+                             min_escape_fraction=config.min_escape_fraction, ground=True,
+                             ground_box_xy_m=ground_box)
     areas = state.areas_m2.copy()
     areas[facade & ~seen] = 0.0
     return replace(state, areas_m2=areas)
