@@ -22,6 +22,7 @@ from dataset.core.orientation import (
     azimuth_deg_from_normal,
     orientation_bin,
 )
+from dataset.core.wwr import ClassAreas
 
 BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
 BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
@@ -37,6 +38,10 @@ class FacadeTruth:
     (arc length for a curved one). ``azimuth_deg`` (clockwise from true north,
     :mod:`dataset.core.orientation`) is derived from ``normal`` and the building's
     ``north_deg`` when the :class:`BuildingTruth` is made (``None``: a vertical normal).
+    ``visible_*_area_m2``: the part seen straight on
+    from the front, not hidden by a railing, a balcony or an overhang
+    (:mod:`dataset.families.visible_facade`); ``None`` where not computed (older files,
+    imported meshes).
     """
 
     id: int
@@ -49,6 +54,9 @@ class FacadeTruth:
     facade_area_m2: float
     wwr: float
     curved: bool = False
+    visible_window_area_m2: float | None = None
+    visible_wall_area_m2: float | None = None
+    visible_door_area_m2: float | None = None
     azimuth_deg: float | None = None
 
     @property
@@ -111,6 +119,16 @@ class BuildingTruth:
         object.__setattr__(self, "facades", tuple(
             replace(f, azimuth_deg=azimuth_deg_from_normal(f.normal, self.north_deg))
             for f in self.facades))
+
+    def visible_areas_m2(self) -> ClassAreas | None:
+        """Window, wall and door areas seen straight on, summed over facades; ``None``
+        unless every facade has them."""
+        parts = [(f.visible_window_area_m2, f.visible_wall_area_m2, f.visible_door_area_m2)
+                 for f in self.facades]
+        if not parts or any(x is None for p in parts for x in p):
+            return None
+        window, wall, door = (float(sum(p[k] for p in parts)) for k in range(3))
+        return ClassAreas(window_m2=window, wall_m2=wall, door_m2=door)
 
     def facade(self, facade_id: int) -> FacadeTruth:
         """The facade with id ``facade_id``."""
