@@ -33,8 +33,10 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-# Run as a script, this file's folder is sys.path[0]: put the repository root there instead.
-sys.path[0] = str(Path(__file__).resolve().parent.parent)
+# Run as a script, this file's folder is sys.path[0]: put the repository root there instead
+# (imported as bench.neural3d_stages, the path is the importer's and stays as it is).
+if not __package__:
+    sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 

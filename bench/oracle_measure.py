@@ -8,9 +8,10 @@ Every building of a preset is rebuilt from its recipe
 becomes a perfect semantic field, :class:`OracleField`:
 
 - **signed distance**: the distance to the nearest of the triangles under the
-  :data:`CANDIDATE_FACES` surface samples nearest the point (samples a third of
-  a voxel apart), within :data:`BAND_VOXELS` voxels of the surface, clipped to
-  that beyond (marching cubes reads only the cells the surface crosses); inside
+  :data:`CANDIDATE_FACES` surface samples nearest the point (random samples about a
+  third of a voxel apart: exact but at a few points near edges, where it may be
+  up to that spacing long), within :data:`BAND_VOXELS` voxels of the surface,
+  clipped to that beyond (marching cubes reads only the cells the surface crosses); inside
   is the union of the mesh's closed bodies (ray parity per body: a chimney
   through a roof stays inside, as with the project's winding-number rule,
   :mod:`dataset.rendering.raycast`);
@@ -107,7 +108,8 @@ class OracleField:
         self.box_min_m = np.asarray(box_min_m, dtype=np.float64)
         self.box_max_m = np.asarray(box_max_m, dtype=np.float64)
         self.band_m = BAND_VOXELS * voxel_m
-        self.bodies = trimesh.Trimesh(mesh.vertices_m, mesh.faces).split(only_watertight=False)
+        self.bodies = trimesh.Trimesh(mesh.vertices_m, mesh.faces).split(only_watertight=False,
+                                                                          repair=False)
         if not all(body.is_watertight for body in self.bodies):
             raise ValueError(f"{name}: a body of the truth mesh is not closed; the oracle's "
                              "inside test (ray parity per body) needs closed bodies")
