@@ -228,6 +228,11 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
                         help=f"field of view in degrees (default {d.fov_deg})")
     render.add_argument("--supersampling", type=int, default=d.supersampling,
                         help="RGB anti-aliasing: rays per pixel along each axis (default 1)")
+    render.add_argument("--context", action="store_true",
+                        help="render the buildings around each building as occluders in every "
+                             "view (sources that know them: CityGML, the lod3 preset); they are "
+                             "background in the labels and the truth is unchanged "
+                             "(docs/importing.md section 8)")
     render.add_argument("--seed", type=int, default=0,
                         help="seed for cameras and looks (default 0)")
     p.add_argument("--workers", type=int, default=1,
@@ -249,7 +254,7 @@ def main(argv: list[str] | None = None) -> int:
     def body() -> int:
         config = GenerateConfig(
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
-            fov_deg=args.fov, supersampling=args.supersampling,
+            fov_deg=args.fov, supersampling=args.supersampling, context=args.context,
         )
         source, path = chosen_source(args, SOURCES)
         if args.executor == "ray" and source is not PRESET_SOURCE:

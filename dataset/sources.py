@@ -1,11 +1,11 @@
 """Every way a building or a scene enters the benchmark: :data:`SOURCES`, the one list.
 
 ``python -m dataset.generate`` offers one option per source flag (``--preset``, ``--mesh``,
-``--ifc``, ``--buildnet3d``) and ``--input PATH``, which takes the first source in this
-order that detects PATH. A new source (a reader of another format) is declared beside its
-reader as a :class:`dataset.importers.source.Source` and added here; the command line then
-offers it (:mod:`dataset.source_args`). The procedural presets are declared here because
-:mod:`dataset.presets` sits above :mod:`dataset.importers` in the data flow.
+``--ifc``, ``--buildnet3d``, ``--citygml``) and ``--input PATH``, which takes the first
+source in this order that detects PATH. A new source (a reader of another format) is
+declared beside its reader as a :class:`dataset.importers.source.Source` and added here; the
+command line then offers it (:mod:`dataset.source_args`). The procedural presets are declared
+here because :mod:`dataset.presets` sits above :mod:`dataset.importers` in the data flow.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from pathlib import Path
 from dataset.importers.blenderproc import BLENDERPROC_SOURCE
 from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE
 from dataset.importers.buildnet3d import BUILDNET3D_SOURCE
+from dataset.importers.citygml_source import CITYGML_SOURCE
 from dataset.importers.source import BuildingEntry, NoOptions, Source
 
 
@@ -48,6 +49,7 @@ PRESET_SOURCE = Source(
     choices=preset_names,
 )
 SOURCES: tuple[Source, ...] = (PRESET_SOURCE, MESH_SOURCE, IFC_SOURCE, BLENDERPROC_SOURCE,
-                               BUILDNET3D_SOURCE)
+                               BUILDNET3D_SOURCE, CITYGML_SOURCE)
 """Every source, in the order ``--input`` tries them (the BlenderProc layout before the
-Blender generator's: a folder of either is told apart by its ``meta_data.json``)."""
+Blender generator's: a folder of either is told apart by its ``meta_data.json``; CityGML
+last: its files are told apart by their root element, a folder by its first file)."""

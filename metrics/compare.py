@@ -49,6 +49,11 @@ from metrics.explain import explain, methods_provenance_text, recorded_steps, ru
 from metrics.html_report import write_report
 from metrics.mesh_pointers import write_mesh_pointers
 from metrics.methods import list_methods, method_specs
+from metrics.orientation_errors import (
+    orientation_errors_of,
+    orientation_table,
+    summarise_orientations,
+)
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report import (
     per_building_table,
@@ -132,7 +137,10 @@ def compare(
     provenance = _provenance(data, results_dir, specs, outcomes, command)
     comment = f"produced by `{command}`; {footer}"
     out_dir.mkdir(parents=True, exist_ok=True)
-    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
+    orientation = orientation_table(summarise_orientations(orientation_errors_of(
+        (o.result, truths.get(o.scene)) for o in outcomes if o.result is not None)))
+    for table in (comparison.table2, comparison.table3, *comparison.more_tables,
+                  replace(orientation, notes=(*orientation.notes, footer))):
         write_table(table, out_dir, comment)
     for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
         for suffix in (".csv", ".md", ".tex"):  # a table with no rows this time: none stale

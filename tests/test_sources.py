@@ -19,6 +19,7 @@ from dataset.examples.ifc_houses import box_house
 from dataset.importers.blenderproc import BLENDERPROC_SOURCE
 from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE, BuildingFileOptions
 from dataset.importers.buildnet3d import BUILDNET3D_SOURCE
+from dataset.importers.citygml_source import CITYGML_SOURCE
 from dataset.importers.import_config import ImportConfig
 from dataset.importers.mesh_import import import_labelled_mesh
 from dataset.importers.source import (
@@ -39,7 +40,7 @@ SMALL = GenerateConfig(resolution=32, views=4)
 
 def test_one_list_names_every_source_once_and_generate_offers_each():
     assert [s.name for s in SOURCES] == ["preset", "mesh", "ifc", "buildnet3d-blenderproc",
-                                         "buildnet3d-blender"]
+                                         "buildnet3d-blender", "citygml"]
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf), pytest.raises(SystemExit):
         generate.main(["--help"])
@@ -57,9 +58,11 @@ def test_each_source_detects_its_own_paths(tmp_path):
     blender = tmp_path / "blender" / "images" / "building3"
     blender.mkdir(parents=True)
     (blender / "meta_data.json").write_text("{}")
+    city = Path(__file__).parent / "fixtures" / "citygml"
     cases = {"tiny": PRESET_SOURCE, str(EXAMPLE): MESH_SOURCE, str(ifc): IFC_SOURCE,
              str(official): BLENDERPROC_SOURCE, str(tmp_path / "blender"): BUILDNET3D_SOURCE,
-             str(blender): BUILDNET3D_SOURCE}
+             str(blender): BUILDNET3D_SOURCE, str(city / "4018259.xml.xz"): CITYGML_SOURCE,
+             str(city): CITYGML_SOURCE}
     for path, source in cases.items():
         assert [s for s in SOURCES if s.detect(path)] == [source], path
     with pytest.raises(ValueError, match="holds nothing these sources read: .*--mesh"):

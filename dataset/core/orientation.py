@@ -31,11 +31,15 @@ BIN_NAMES: dict[OrientationBin, str] = {"N": "north", "E": "east", "S": "south",
 BIN_CENTRE_DEG: dict[OrientationBin, float] = {"N": 0.0, "E": 90.0, "S": 180.0, "W": 270.0}
 BIN_HALF_WIDTH_DEG = 45.0
 
-NorthSource = Literal["convention", "ifc_true_north", "ifc_map_conversion", "user"]
-NORTH_SOURCES: tuple[str, ...] = ("convention", "ifc_true_north", "ifc_map_conversion", "user")
+NorthSource = Literal["convention", "ifc_true_north", "ifc_map_conversion", "crs_convergence",
+                      "user"]
+NORTH_SOURCES: tuple[str, ...] = ("convention", "ifc_true_north", "ifc_map_conversion",
+                                  "crs_convergence", "user")
 """Where ``north_deg`` comes from: ``convention`` (+y is true north unless the source says
 otherwise: procedural scenes, and imported files that give no north), the IFC model's
-``TrueNorth`` or its ``IfcMapConversion`` (grid north), or the user (``--north-deg``)."""
+``TrueNorth`` or its ``IfcMapConversion`` (grid north), the meridian convergence of a
+georeferenced file's projected CRS at the building (+y is the CRS's grid north: CityGML,
+:mod:`dataset.importers.grid_north`), or the user (``--north-deg``)."""
 
 MIN_HORIZONTAL_NORMAL = 1e-6  # a normal this close to vertical has no azimuth
 

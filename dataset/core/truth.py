@@ -13,8 +13,10 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from dataset.core.appearance import SurfaceAppearance
 from dataset.core.atomic import write_json_atomic
 from dataset.core.mesh import LabelledMesh
+from dataset.core.neighbours import Neighbour
 from dataset.core.orientation import (
     NORTH_SOURCES,
     NorthSource,
@@ -24,8 +26,12 @@ from dataset.core.orientation import (
 )
 from dataset.core.wwr import ClassAreas
 
-BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
-BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
+BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported", "with_balconies",
+                       "terraced", "detached"]
+BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported",
+                                   "with_balconies", "terraced", "detached")
+"""The procedural families, ``imported`` (a mesh or IFC model), and the types CityGML
+buildings get from their geometry (:mod:`dataset.importers.citygml_type`)."""
 _DERIVED_FACADE_KEYS = ("azimuth_deg", "orientation")
 
 
@@ -162,10 +168,23 @@ class BuildingTruth:
 
 @dataclass(frozen=True)
 class Building:
-    """A building as the generator (or the importer) makes it: labelled mesh + exact truth."""
+    """A building as the generator (or the importer) makes it: labelled mesh + exact truth.
+
+    Where the source knows them: ``appearance``, the mesh faces' textures and colours
+    (:mod:`dataset.core.appearance`), and ``context``, the buildings around it
+    (:mod:`dataset.core.neighbours`); neither changes the truth.
+    """
 
     mesh: LabelledMesh
     truth: BuildingTruth
+    appearance: SurfaceAppearance | None = None
+    context: tuple[Neighbour, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.appearance is not None and len(self.appearance.face_material) != len(
+                self.mesh.faces):
+            raise ValueError("a building's appearance needs one entry per face of its mesh")
+        object.__setattr__(self, "context", tuple(self.context))
 
 
 def write_building(path: str | Path, truth: BuildingTruth) -> None:

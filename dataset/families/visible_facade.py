@@ -63,32 +63,46 @@ def _hidden_in_plane(triangles: np.ndarray, members: np.ndarray, labels: np.ndar
     """Hidden area per class of the coplanar facade triangles ``members`` facing ``normal``."""
     u, v = (b[0] for b in plane_bases(normal[None, :]))
     basis = np.stack([u, v])
-    origin = triangles[members[0], 0]
     own = triangles[members] @ basis.T  # (M, 3, 2)
-    lo, hi = own.reshape(-1, 2).min(axis=0), own.reshape(-1, 2).max(axis=0)
-    depth = (triangles - origin) @ normal  # (F, 3): metres in front of the plane
     others = np.ones(len(triangles), dtype=bool)
     others[members] = False
-    flat = triangles @ basis.T  # (F, 3, 2)
-    edges = flat[:, 1:] - flat[:, :1]
-    flat_area = 0.5 * np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
-    # Faces edge-on to the plane (reveals, the sides of a slab) cast no shadow.
-    candidates = others & (depth.max(axis=1) > IN_FRONT_TOL_M) & (flat_area > MIN_SHADOW_M2)
-    candidates &= np.all(flat.max(axis=1) > lo, axis=1) & np.all(flat.min(axis=1) < hi, axis=1)
-    whole = candidates & (depth.min(axis=1) > IN_FRONT_TOL_M)
-    shadows = list(shapely.polygons(flat[whole]))
-    for i in np.flatnonzero(candidates & ~whole):
-        ring = _clip_in_front(triangles[i], depth[i])
-        if len(ring) >= 3:
-            shadows.append(Polygon(ring @ basis.T))
-    if not shadows:
+    shadow = front_shadow(triangles, others, triangles[members[0], 0], normal, basis,
+                          (*own.reshape(-1, 2).min(axis=0), *own.reshape(-1, 2).max(axis=0)))
+    if shadow.is_empty:
         return {}
-    shadow = shapely.union_all(shadows)
     out: dict[int, float] = {}
     for label in np.unique(labels):
         faces = shapely.union_all(shapely.polygons(own[labels == label]))
         out[int(label)] = float(faces.intersection(shadow).area)
     return out
+
+
+def front_shadow(triangles_m: np.ndarray, occluders: np.ndarray, origin_m: np.ndarray,
+                 normal: np.ndarray, basis: np.ndarray, bounds_uv: tuple[float, ...]):
+    """What the ``occluders`` hide of a plane seen straight on from the front (shapely, m).
+
+    triangles_m : (F, 3, 3) float, world metres. occluders : (F,) bool, the triangles that
+    may hide the plane. origin_m : (3,) a point of the plane; normal : (3,) its outward unit
+    normal; basis : (2, 3) orthonormal in-plane axes (the result's u, v). bounds_uv :
+    (u_min, v_min, u_max, v_max) of the region of interest. The part of each occluder in
+    front of the plane (more than :data:`IN_FRONT_TOL_M`) is projected along the normal;
+    the union of those shadows is returned (empty when nothing is in front).
+    """
+    lo, hi = np.asarray(bounds_uv[:2]), np.asarray(bounds_uv[2:])
+    depth = (triangles_m - origin_m) @ normal  # (F, 3): metres in front of the plane
+    flat = triangles_m @ basis.T  # (F, 3, 2)
+    edges = flat[:, 1:] - flat[:, :1]
+    flat_area = 0.5 * np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
+    # Faces edge-on to the plane (reveals, the sides of a slab) cast no shadow.
+    candidates = occluders & (depth.max(axis=1) > IN_FRONT_TOL_M) & (flat_area > MIN_SHADOW_M2)
+    candidates &= np.all(flat.max(axis=1) > lo, axis=1) & np.all(flat.min(axis=1) < hi, axis=1)
+    whole = candidates & (depth.min(axis=1) > IN_FRONT_TOL_M)
+    shadows = list(shapely.polygons(flat[whole]))
+    for i in np.flatnonzero(candidates & ~whole):
+        ring = _clip_in_front(triangles_m[i], depth[i])
+        if len(ring) >= 3:
+            shadows.append(Polygon(ring @ basis.T))
+    return shapely.union_all(shadows) if shadows else Polygon()
 
 
 def _clip_in_front(triangle: np.ndarray, depth: np.ndarray) -> np.ndarray:
