@@ -103,12 +103,14 @@ def test_grouping_config_and_ungrouped_area(banded_box):
     assert ungrouped.ungrouped_facade_area_m2 == pytest.approx(ungrouped.facade_area_m2, rel=1e-12)
 
 
-def _recessed_box(voxel_size_m: float = 0.05):
-    """6 x 4 x 10 m box with two 1 x 1.2 m windows per side recessed 0.3 m, and an underside.
+def _recessed_box(voxel_size_m: float = 0.05, *, window_m: tuple[float, float] = (1.0, 1.2),
+                  depth_m: float = 0.3):
+    """6 x 4 x 10 m box with two ``window_m`` (width, height; default 1 x 1.2 m) windows per
+    side, their bottom 4 m up, recessed ``depth_m``, and an underside.
 
     Labels: window on the pane and the reveals, roof on top, wall elsewhere, the
     underside (z = 0) included, as a neural field closing the building at the
-    ground labels it. Truth: window 8 x 1.2 m², gross facade 200 m².
+    ground labels it. Truth: window 8 x 1.2 m², gross facade 200 m² (by default).
     """
     lo, hi = np.array([-3.0, -2.0, 0.0]), np.array([3.0, 2.0, 10.0])
     recesses = []
@@ -116,9 +118,9 @@ def _recessed_box(voxel_size_m: float = 0.05):
         other = 1 - axis
         for side in (lo[other], hi[other]):
             for u0 in (-0.5 * size + 1.0, 0.5 * size - 2.0):
-                r_lo, r_hi = np.array([0, 0, 4.0]), np.array([0, 0, 5.2])
-                r_lo[axis], r_hi[axis] = u0, u0 + 1.0
-                r_lo[other], r_hi[other] = side - 0.3, side + 0.3
+                r_lo, r_hi = np.array([0, 0, 4.0]), np.array([0, 0, 4.0 + window_m[1]])
+                r_lo[axis], r_hi[axis] = u0, u0 + window_m[0]
+                r_lo[other], r_hi[other] = side - depth_m, side + depth_m
                 recesses.append((r_lo, r_hi))
 
     def sdf(p):

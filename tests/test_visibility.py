@@ -59,6 +59,38 @@ def test_ground_stops_downward_rays():
     np.testing.assert_array_equal(grounded, 0.0)
 
 
+def test_a_ground_box_lets_the_wall_under_an_eave_see_down_past_it():
+    # A 4 x 4 x 3 m box under a roof slab that overhangs 1 m all round, with a fascia
+    # hanging 0.4 m from the slab's edge: the wall's top 0.2 m sees the slab above and the
+    # fascia straight out, so only downward rays leave. A ground without end stops them
+    # all; the ground in the mesh's x/y box lets those that pass under the fascia go.
+    parts = [trimesh.creation.box([4.0, 4.0, 3.0]), trimesh.creation.box([6.0, 6.0, 0.2]),
+             *[trimesh.creation.box(size) for size in ([0.05, 6.0, 0.4], [0.05, 6.0, 0.4])]]
+    for part, shift in zip(parts, ([0, 0, 1.5], [0, 0, 3.1], [2.975, 0, 2.8], [-2.975, 0, 2.8])):
+        part.apply_translation(shift)
+    mesh = trimesh.util.concatenate(parts)
+    rc = Raycaster.from_triangles(mesh.vertices, mesh.faces)
+    band = np.array([[[2.0, -0.5, 2.8], [2.0, 0.5, 2.8], [2.0, 0.0, 3.0]]])  # facing +x
+    box_xy = np.array([[-3.0, -3.0], [3.0, 3.0]])
+
+    def fraction(**ground):
+        return escape_fractions(rc, band, _normals(band), rays_per_sample=64, offset_m=1e-3,
+                                **ground)[0]
+
+    assert fraction(ground=True) == 0.0
+    assert fraction(ground=True, ground_box_xy_m=box_xy) > 0.02
+    assert fraction(ground=True, ground_box_xy_m=box_xy) < fraction()  # the ground still counts
+    # the inner sides of an open-bottomed box meet the ground inside its box: still nothing
+    box = trimesh.creation.box([4.0, 4.0, 3.0])
+    box.apply_translation([0, 0, 1.5])
+    walls_and_roof = box.faces[box.face_normals[:, 2] > -0.5]
+    tri = box.vertices[walls_and_roof[:, ::-1]]
+    inner = escape_fractions(Raycaster.from_triangles(box.vertices, walls_and_roof), tri,
+                             _normals(tri), rays_per_sample=16, offset_m=1e-3, ground=True,
+                             ground_box_xy_m=np.array([[-2.0, -2.0], [2.0, 2.0]]))
+    np.testing.assert_array_equal(inner, 0.0)
+
+
 def test_bad_shapes_are_refused():
     box = trimesh.creation.box()
     with pytest.raises(ValueError, match=r"\(F, 3, 3\)"):
