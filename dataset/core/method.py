@@ -13,7 +13,7 @@ The truth is out of a method's reach: ``scene`` is a
 and semantic images the method declares in ``inputs``), never the
 :class:`~dataset.core.scene_record.Scene` with its ``building.json``; metrics reads the
 truth itself. A method's results must not change when ``building.json``, ``mesh.ply`` or
-the facade-id images are removed (``tests/test_truth_blind.py`` checks the built-in ones).
+the facade-id images are removed (``tests/metrics/test_truth_blind.py`` checks the built-in ones).
 
 Another package adds a method without touching this repository by exposing a
 :class:`Method` (or a zero-argument callable returning one) under the entry

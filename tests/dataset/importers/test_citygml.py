@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 import shapely
 import shapely.affinity
+from paths import FIXTURES
 
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import geojson_to_polygon
@@ -25,7 +26,7 @@ from dataset.importers.citygml_polygons import newell_normal
 from dataset.importers.citygml_read import read_citygml
 from dataset.importers.grid_north import grid_north_deg
 
-FIXTURES = Path(__file__).parent / "fixtures" / "citygml"
+FIXTURES = FIXTURES / "citygml"
 IDS = ("4018259", "4018133", "4018149b")
 AREA_RTOL = 1e-3  # the 0.1 %
 

@@ -8,16 +8,16 @@ import io
 import json
 import re
 import sys
-from pathlib import Path
 
 import pytest
+from paths import REPO_ROOT
 
 from dataset.core.method import ENTRY_POINT_GROUP, installed_methods
 from metrics.compare import main
 from metrics.report import read_building_errors_csv
 from metrics.tables import read_csv_rows
 
-DOC = Path(__file__).resolve().parent.parent / "docs" / "adding-a-method.md"
+DOC = REPO_ROOT / "docs" / "adding-a-method.md"
 
 
 def doc_blocks(language: str) -> list[str]:

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
+from paths import REPO_ROOT
 from shapely.geometry import Polygon
 
 from dataset.core.classes import SemanticClass
@@ -26,7 +27,7 @@ from dataset.importers.mesh_import import ImportConfig, import_labelled_mesh
 from dataset.presets import build_building, preset_recipes
 
 REL = 1e-6
-EXAMPLES = Path(__file__).resolve().parents[1] / "dataset" / "examples"
+EXAMPLES = REPO_ROOT / "dataset" / "examples"
 
 # The example BIM building (make_example_bim.py), by hand. Facade ids follow the outward
 # normal's azimuth counter-clockwise from +x: east, north, west, south.

@@ -4,11 +4,11 @@ extracted again, a partial one is resumed, anything else is trained afresh."""
 import ast
 import json
 from dataclasses import replace
-from pathlib import Path
 
 import pytest
 import torch
 from neural3d_scene import write_ring_scene
+from paths import REPO_ROOT
 
 from dataset.core.scene_record import scene_name
 from dataset.scenes.scene import read_method_input
@@ -21,7 +21,7 @@ from neural3d.training.run_folder import TRAINING_CODE, prior_run, training_prov
 CPU = torch.device("cpu")
 STEPS = 20
 BUDGET = Neural3dBudget(preset="tiny", steps=STEPS, threads=1, resolution=24, eval_frames=1)
-REPO = Path(__file__).resolve().parent.parent
+REPO = REPO_ROOT
 
 
 @pytest.fixture(scope="module")

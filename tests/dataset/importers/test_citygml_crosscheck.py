@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import FIXTURES
 
 from dataset.core.classes import SemanticClass
 from dataset.core.mesh import LabelledMesh
@@ -21,7 +22,7 @@ from dataset.importers.citygml_polygons import triangulate_polygon
 from dataset.importers.citygml_preset import LOD3_DIR
 from dataset.importers.citygml_read import read_citygml
 
-FIXTURES = Path(__file__).parent / "fixtures" / "citygml"
+FIXTURES = FIXTURES / "citygml"
 AGREE = 0.02
 PIXEL_M = 0.02  # coarser than the bench's 1 cm to keep the test fast; aliasing stays < 1 %
 

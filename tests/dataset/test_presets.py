@@ -9,6 +9,7 @@ import pytest
 from building_checks import check_building, check_closed_bodies, check_no_coplanar_overlap
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from paths import REPO_ROOT
 
 from dataset.core.mesh import LabelledMesh, write_labelled_ply
 from dataset.core.truth import Building, write_building
@@ -23,7 +24,7 @@ from dataset.presets import (
     preset_recipes,
 )
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO_ROOT
 RANGES = {
     "skyscraper": (skyscraper.FLOORS_RANGE, skyscraper.FOOTPRINT_RANGE_M2,
                    skyscraper.HEIGHT_RANGE_M, skyscraper.WWR_RANGE),

@@ -12,12 +12,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 from lxml import etree
+from paths import FIXTURES
 
 from dataset.importers.citygml_files import CityGmlError
 from dataset.importers.citygml_import import import_citygml
 from dataset.importers.citygml_read import read_citygml
 
-FIXTURE = Path(__file__).parent / "fixtures" / "citygml" / "4018259.xml.xz"
+FIXTURE = FIXTURES / "citygml" / "4018259.xml.xz"
 
 
 def _tree() -> etree._ElementTree:

@@ -1,7 +1,7 @@
 """neural3d on a CUDA GPU: the same field renders, trains, loads and measures as on the CPU.
 
 Skipped where torch sees no GPU (CI never has one); run on a lent GPU machine with
-``python -m pytest tests/test_neural3d_cuda.py`` (docs/neural3d.md, "On a GPU").
+``python -m pytest tests/neural3d/test_neural3d_cuda.py`` (docs/neural3d.md, "On a GPU").
 """
 
 import copy

@@ -8,8 +8,9 @@ import ast
 from pathlib import Path
 
 import pytest
+from paths import REPO_ROOT
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO_ROOT
 # A package may import the packages of a lower layer and its own, nothing later in the flow.
 LAYER = {"dataset": 0, "baselines": 1, "neural3d": 1, "metrics": 2, "figures": 3}
 

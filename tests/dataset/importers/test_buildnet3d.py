@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import FIXTURES
 from PIL import Image
 
 from baselines.wwr2dss import run_2dss
@@ -33,7 +34,7 @@ from dataset.scenes.labels import class_mapping
 from dataset.scenes.scene import read_method_input, read_scene
 from dataset.scenes.scene_validation import read_frame_labels
 
-FIXTURE = Path(__file__).parent / "fixtures" / "buildnet3d_generator"
+FIXTURE = FIXTURES / "buildnet3d_generator"
 GEN = dict(zip(class_mapping("generator").names, class_mapping("generator").colours))
 OURS = {"background": C.BACKGROUND, "wall": C.WALL, "window": C.WINDOW, "roof": C.ROOF}
 BUILDINGS = (0, 1)

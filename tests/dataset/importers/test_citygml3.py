@@ -4,16 +4,16 @@ truth (tests/fixtures/citygml/ogc, MIT)."""
 from __future__ import annotations
 
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import FIXTURES
 
 from dataset.core.classes import SemanticClass
 from dataset.importers.citygml_import import import_citygml
 from dataset.importers.citygml_read import read_citygml
 
-OGC = Path(__file__).parent / "fixtures" / "citygml" / "ogc"
+OGC = FIXTURES / "citygml" / "ogc"
 V2, V3 = OGC / "Building_LOD3-EPSG25832.v2.gml.xz", OGC / "Building_LOD3-EPSG25832.v3.gml.xz"
 
 

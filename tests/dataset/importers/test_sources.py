@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 from conftest import make_box_building
+from paths import FIXTURES, REPO_ROOT
 
 import dataset.importers.building_file as building_file
 from dataset import generate, importer
@@ -34,7 +35,7 @@ from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import GenerateConfig, scene_changes
 from dataset.sources import PRESET_SOURCE, SOURCES
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "dataset" / "examples" / "example_bim.ply"
+EXAMPLE = REPO_ROOT / "dataset" / "examples" / "example_bim.ply"
 SMALL = GenerateConfig(resolution=32, views=4)
 
 
@@ -58,7 +59,7 @@ def test_each_source_detects_its_own_paths(tmp_path):
     blender = tmp_path / "blender" / "images" / "building3"
     blender.mkdir(parents=True)
     (blender / "meta_data.json").write_text("{}")
-    city = Path(__file__).parent / "fixtures" / "citygml"
+    city = FIXTURES / "citygml"
     cases = {"tiny": PRESET_SOURCE, str(EXAMPLE): MESH_SOURCE, str(ifc): IFC_SOURCE,
              str(official): BLENDERPROC_SOURCE, str(tmp_path / "blender"): BUILDNET3D_SOURCE,
              str(blender): BUILDNET3D_SOURCE, str(city / "4018259.xml.xz"): CITYGML_SOURCE,

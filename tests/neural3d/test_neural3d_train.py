@@ -9,6 +9,7 @@ import pytest
 import torch
 from conftest import BOX_SIZE_M
 from neural3d_scene import write_ring_scene
+from paths import REPO_ROOT
 
 from neural3d.config import preset_config
 from neural3d.field.checkpoint import read_checkpoint
@@ -170,9 +171,8 @@ def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
 
 def test_train_step_is_the_only_training_step():
     """bench/neural3d.py calls neural3d.training.step.train_step; no loss/backward of its own."""
-    from pathlib import Path
 
-    bench = (Path(__file__).resolve().parent.parent / "bench" / "neural3d.py").read_text()
+    bench = (REPO_ROOT / "bench" / "neural3d.py").read_text()
     assert "train_step(" in bench
     for copy in ("total_loss", ".backward(", "render_rays", "torch.optim.Adam"):
         assert copy not in bench, f"bench/neural3d.py has its own {copy}"
@@ -185,9 +185,8 @@ def test_sigterm_saves_a_checkpoint_like_ctrl_c(scene, tmp_path):
     import subprocess
     import sys
     import time
-    from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
+    root = REPO_ROOT
     env = {**os.environ, "PYTHONPATH": str(root), "OMP_NUM_THREADS": "1"}
     proc = subprocess.Popen(
         [sys.executable, "-m", "neural3d.train", "--scene", str(scene), "--preset", "tiny",

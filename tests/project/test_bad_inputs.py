@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from bad_scene_edits import IDEAL, SCENE_EDITS, TABLE_ROWS, TRAIN, unknown_class_id
 from conftest import make_box_building
+from paths import REPO_ROOT
 
 from baselines import wwr2ds, wwr2dss
 from dataset import generate, importer
@@ -32,7 +33,7 @@ from neural3d import extract, train
 from neural3d.config import config_to_dict, preset_config
 from neural3d.field.normalisation import Normalisation
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO_ROOT
 BASELINES = {"2D-S": wwr2ds.main, "2D-SS": wwr2dss.main}
 
 

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
+
+from paths import FIXTURES
 
 from dataset.core.truth import read_building
 from dataset.generate import main
@@ -11,7 +12,7 @@ from dataset.importers.citygml_import import import_citygml
 from dataset.importers.citygml_preset import LOD3_DIR, lod3_entries, lod3_files
 from dataset.presets import build_building, preset_recipes
 
-FIXTURES = Path(__file__).parent / "fixtures" / "citygml"
+FIXTURES = FIXTURES / "citygml"
 TINY = ["--resolution", "48", "--views", "2", "--quiet"]
 
 

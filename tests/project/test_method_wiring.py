@@ -5,7 +5,9 @@ name a method, code may not."""
 import ast
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from paths import REPO_ROOT
+
+ROOT = REPO_ROOT
 METHOD_NAMES = frozenset({"2D-S", "2D-SS", "neural3d"})
 # the paper's own method names, transcribed with its figures (they coincide with ours)
 PAPER_FIGURES = "metrics/paper_tables.py"

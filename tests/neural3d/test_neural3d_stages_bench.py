@@ -5,17 +5,17 @@ import json
 import subprocess
 import sys
 from dataclasses import replace
-from pathlib import Path
 
 import pytest
 import torch
 from neural3d_scene import write_ring_scene
+from paths import REPO_ROOT
 
 from neural3d.config import preset_config
 from neural3d.method import RUNS_FOLDER
 from neural3d.train import train
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO_ROOT
 
 
 def _bench(*args: str) -> subprocess.CompletedProcess:

@@ -120,7 +120,7 @@ def test_front_seen_faces_are_the_facade_a_camera_in_front_meets_first():
 
 
 def test_faces_the_hemisphere_test_drops_but_the_front_sees_count():
-    """Square slot windows (0.4 m, recessed 0.38 m) in a box (tests/test_measure.py): few
+    """Square slot windows (0.4 m, recessed 0.38 m) in a box (tests/neural3d/test_measure.py): few
     hemisphere rays leave a slot, and the test drops part of the panes and reveals (window
     1.02 m² measured; 1.59 m² without the test, 1.28 m² true); seen from in front they
     count again, never more than without the test. (A wide recess keeps its pane: its

@@ -3,10 +3,10 @@ remapping."""
 
 import json
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import REPO_ROOT
 
 from dataset.core.camera import Intrinsics, look_at, project_world_to_image
 from dataset.core.classes import SemanticClass
@@ -159,7 +159,7 @@ def test_remap_colour_coded_masks():
 def test_scene_box_around_the_building_and_partial_boxes_completed(tmp_path):
     from dataset.importers.mesh_import import import_labelled_mesh
 
-    example = Path(__file__).resolve().parents[1] / "dataset" / "examples" / "example_bim.ply"
+    example = REPO_ROOT / "dataset" / "examples" / "example_bim.ply"
     truth = import_labelled_mesh(example).truth
     write_meta_data(replace(_scene(tmp_path), building=truth), tmp_path)
     box = json.loads((tmp_path / "meta_data.json").read_text())["scene_box"]

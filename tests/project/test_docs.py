@@ -7,8 +7,9 @@ from functools import cache
 from pathlib import Path
 
 import pytest
+from paths import REPO_ROOT
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = REPO_ROOT
 PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
 FOLDERS = (*PACKAGES, "tests", "bench", "scripts", "docs")
 DOCS = sorted(p for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]

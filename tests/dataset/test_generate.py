@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from conftest import TINY_CONFIG, assert_complete_scene, make_box_building
+from paths import REPO_ROOT
 
 import dataset.scenes.scene_writer as scene_writer
 from dataset.core.truth import Building
@@ -85,7 +86,7 @@ def test_preset_run_is_resumable(tmp_path, monkeypatch):
 @pytest.fixture()
 def box_ply() -> Path:
     """The importer's closed example mesh (building id ``example_bim``)."""
-    return Path(__file__).resolve().parents[1] / "dataset" / "examples" / "example_bim.ply"
+    return REPO_ROOT / "dataset" / "examples" / "example_bim.ply"
 
 
 def test_cli_generates_a_users_mesh_and_resumes(tmp_path, box_ply, capsys):

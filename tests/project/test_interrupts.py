@@ -13,11 +13,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import REPO_ROOT
 
 from dataset.core.results import read_result
 from dataset.scenes.scene import read_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = REPO_ROOT
 
 
 def _interrupt(argv: list[str], ready: Path, sig: int, delay_s: float) -> tuple[int, str]:

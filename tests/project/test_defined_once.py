@@ -9,7 +9,9 @@ import ast
 from functools import cache
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from paths import REPO_ROOT
+
+ROOT = REPO_ROOT
 PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
 # Importers that issue 17 works on at the same time as this check was written; their frame
 # splits are converted to dataset.core.protocols' names when both branches meet.

@@ -12,17 +12,17 @@ for the elevations, 5 % of the facade and 0.01 of WWR, footprint IoU 0.98.
 from __future__ import annotations
 
 import lzma
-from pathlib import Path
 
 import numpy as np
 import pytest
+from paths import FIXTURES
 
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.importers.ifc_checks import elevation_areas, footprint_iou, plan_footprint
 from dataset.importers.ifc_import import building_from_ifc, read_ifc
 from dataset.importers.import_config import ImportConfig
 
-FIXTURES = Path(__file__).parent / "fixtures" / "ifc_real"
+FIXTURES = FIXTURES / "ifc_real"
 
 
 def _import(name: str, tmp_path_factory):
