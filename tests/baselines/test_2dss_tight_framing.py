@@ -43,6 +43,7 @@ def write_tight_scene(building, root, below_px: float):
     return read_method_input(root)
 
 
+@pytest.mark.slow
 def test_a_foot_on_the_bottom_border_is_not_a_cut(box_building, tmp_path):
     """Measured: WWR 0.1579 v truth 0.1568 (0.7 %), the same as with the foot 20 px above
     the border; the old rule (ground_contact_px=0) skipped all four views."""

@@ -24,6 +24,7 @@ def test_scene_folders_and_default_results_folder(tmp_path):
         scene_folders(tmp_path / "nowhere")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("views", ["ideal", "multi"])
 def test_both_clis_on_the_tiny_benchmark(tiny_benchmark, tmp_path, views):
     out = tmp_path / "results"

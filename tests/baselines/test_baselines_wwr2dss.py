@@ -71,6 +71,7 @@ def _pixel_centres_in(lo_px: float, hi_px: float) -> float:
     return float(np.floor(hi_px - 0.5) - np.ceil(lo_px - 0.5) + 1)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scale, distance_m", [(1, 34.0), (1, 36.0), (2, 34.0)])
 def test_ideal_view_wwr_is_the_pixel_count_of_the_point_sampled_mask(scale, distance_m):
     # A skyscraper-like facade (6.6 x 34 m, two window columns) seen head-on

@@ -57,6 +57,7 @@ def _fake_presets(monkeypatch, calls: list):
     monkeypatch.setitem(sys.modules, "dataset.presets", fake)
 
 
+@pytest.mark.slow
 def test_preset_run_is_resumable(tmp_path, monkeypatch):
     calls: list = []
     _fake_presets(monkeypatch, calls)
@@ -156,6 +157,7 @@ def test_cli_help_explains_the_options(capsys):
         assert option in text
 
 
+@pytest.mark.slow
 def test_scene_made_by_other_code_is_rerendered_with_the_reason(tmp_path, monkeypatch):
     calls: list = []
     _fake_presets(monkeypatch, calls)

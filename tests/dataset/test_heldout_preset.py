@@ -1,5 +1,7 @@
 """The heldout preset: seeds the paper preset never drew from, every held-out design once."""
 
+import pytest
+
 from dataset.families.heldout_params import HELDOUT_MODELS
 from dataset.presets import build_building, preset_recipes
 
@@ -21,6 +23,7 @@ def test_heldout_recipes_are_new_seeds_and_new_designs():
     assert sum(r.family == "l_shaped" for r in recipes) == 6
 
 
+@pytest.mark.slow
 def test_every_heldout_design_builds_with_its_visible_truth():
     for recipe in preset_recipes("heldout"):
         if recipe.family != "realistic":

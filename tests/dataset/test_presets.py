@@ -78,6 +78,7 @@ def test_same_recipe_gives_identical_files(tiny_buildings, tmp_path):
         assert a == b, recipe.id
 
 
+@pytest.mark.slow
 def test_files_are_identical_across_processes(tiny_buildings, tmp_path):
     # Another interpreter (fresh hash seeds, fresh import order) writes the same bytes.
     code = (
@@ -94,6 +95,7 @@ def test_files_are_identical_across_processes(tiny_buildings, tmp_path):
     assert mine == other
 
 
+@pytest.mark.slow
 def test_paper_preset_has_28_buildings_in_the_family_ranges(paper_truths):
     recipes = preset_recipes("paper")
     assert len({r.id for r in recipes}) == 28
@@ -109,11 +111,13 @@ def test_paper_preset_has_28_buildings_in_the_family_ranges(paper_truths):
         assert wwr[0] <= truth.wwr <= wwr[1], truth.id
 
 
+@pytest.mark.slow
 def test_paper_buildings_agree_with_their_meshes(paper_buildings):
     for building in paper_buildings:
         check_building(building)
 
 
+@pytest.mark.slow
 @settings(max_examples=5, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), model=st.sampled_from(REALISTIC_MODELS))
 def test_any_seed_gives_a_building_that_agrees_with_its_mesh(seed, model):

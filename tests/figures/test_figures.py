@@ -19,6 +19,8 @@ from figures.make import main
 from figures.meshes import face_labels_from_vertices, render_mesh_views
 from metrics.compare import main as compare_main
 
+pytestmark = pytest.mark.slow  # every test here makes figures from a tiny comparison
+
 ALL_FIGURES = ("table1_dataset", "dataset_renders", "2dss_pipeline", "neural3d_meshes",
                "footprint_overlays", "errors_by_family", "wwr_scatter", "iou_per_building")
 SIZE = 24  # px: small frames keep the test fast
@@ -84,6 +86,7 @@ def figures_made(ready_made, tmp_path_factory):
     return out, stdout.getvalue(), stderr.getvalue()
 
 
+@pytest.mark.slow
 def test_every_figure_is_made_from_ready_made_inputs(figures_made):
     out, stdout, stderr = figures_made
     assert "skipped" not in stderr
@@ -104,6 +107,7 @@ def test_table1_uses_the_data_recorded_by_compare(figures_made):
     assert (out / "table1_dataset.tex").read_text().startswith("% produced by")
 
 
+@pytest.mark.slow
 def test_missing_inputs_are_skipped_with_a_message(tmp_path, capsys):
     data, results = make_benchmark(tmp_path)
     out = tmp_path / "compare"

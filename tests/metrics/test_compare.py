@@ -34,6 +34,7 @@ def _rows_by_key(path):
     return {(r["family"], r["method"], r["protocol"]): r for r in rows}
 
 
+@pytest.mark.slow
 def test_table2_reproduces_the_hand_computed_errors(compared):
     out, _ = compared
     t2 = _rows_by_key(out / "table2_errors.csv")
@@ -143,6 +144,7 @@ def test_a_device_that_is_not_here_is_refused_when_something_would_run(tmp_path,
     assert err.startswith("error: ") and "torch sees" in err and err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_no_run_reads_results_of_a_device_that_is_not_here(tmp_path):
     """Results made on a GPU machine are read and tabled on one without a GPU."""
     data, results = make_benchmark(tmp_path)
@@ -153,6 +155,7 @@ def test_no_run_reads_results_of_a_device_that_is_not_here(tmp_path):
     assert (tmp_path / "o" / "table2_errors.md").is_file()
 
 
+@pytest.mark.slow
 def test_runs_the_2d_methods_on_the_tiny_benchmark_then_reuses_them(tiny_benchmark, tmp_path):
     argv = ["--data", str(tiny_benchmark), "--methods", "2D-S,2D-SS", "--views", "ideal",
             "--results", str(tmp_path / "results"), "--out", str(tmp_path / "out")]
@@ -175,6 +178,7 @@ def test_runs_the_2d_methods_on_the_tiny_benchmark_then_reuses_them(tiny_benchma
     assert {r["status"] for r in prov["runs"]} == {"reused"}
 
 
+@pytest.mark.slow
 def test_a_second_comparison_leaves_no_stale_plot_or_footprint(tmp_path):
     data, results = make_benchmark(tmp_path)
     out = tmp_path / "out"

@@ -27,6 +27,8 @@ from metrics.executors import make_executor
 from metrics.methods import method_specs
 from metrics.runner import MethodSpec, find_scenes, run_missing
 
+pytestmark = pytest.mark.slow  # every test here starts a local Ray cluster
+
 # Before Ray is first imported (it reads its settings then): no usage reports, loopback only.
 os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
 os.environ.setdefault(LOCAL_ONLY_ENV, "0")
@@ -90,6 +92,7 @@ def _csv_body(path: Path) -> str:
     return "".join(lines[1:])
 
 
+@pytest.mark.slow
 def test_2d_methods_give_the_same_tables_with_ray_and_local(local_ray, tiny_benchmark, tmp_path):
     tables = {}
     for name in ("local", "ray"):
@@ -118,6 +121,7 @@ def test_a_task_the_cluster_cannot_place_is_refused_and_names_are_checked(
         make_executor("slurm")
 
 
+@pytest.mark.slow
 def test_a_killed_worker_is_retried_and_no_result_is_lost_or_doubled(
         local_ray, tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
@@ -136,6 +140,7 @@ def test_a_killed_worker_is_retried_and_no_result_is_lost_or_doubled(
         replace(o.result, wall_time_s=0.0) for o in local]
 
 
+@pytest.mark.slow
 def test_retries_are_bounded_and_an_input_failure_is_not_retried(
         local_ray, tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
@@ -154,6 +159,7 @@ def test_retries_are_bounded_and_an_input_failure_is_not_retried(
     assert len(messages) == 2 and not (tmp_path / "results" / f"{dies}__2D-S__ideal.json").exists()
 
 
+@pytest.mark.slow
 def test_a_scene_reaches_the_worker_without_a_shared_folder(local_ray, tiny_benchmark, tmp_path):
     """The method removes the driver's scene folder before reading its own copy, and writes
     an artefacts folder that comes back to the driver (as neural3d's run folder does)."""
@@ -181,6 +187,7 @@ def test_a_scene_reaches_the_worker_without_a_shared_folder(local_ray, tiny_benc
     assert mesh.read_bytes() == b"ply\ntiny_skyscraper"
 
 
+@pytest.mark.slow
 def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
         local_ray, tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
@@ -232,6 +239,7 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
     assert len(again) == 2 * len(scenes)
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     """``python -m metrics.compare --executor ray`` (its own Ray) gets SIGINT after its first
     result, while neural3d (100000 steps per building) still runs or waits."""

@@ -57,6 +57,7 @@ def geomeppy_export(tmp_path_factory):
     return json.loads((out / "geomeppy.json").read_text())["buildings"]["box"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["truth", "2D-SS"])
 def test_geomeppy_round_trip(geomeppy_export, method):
     entry = next(e for e in geomeppy_export["estimates"] if e["method"] == method)

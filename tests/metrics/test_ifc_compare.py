@@ -7,12 +7,15 @@ Table 2 and Table 3 rows for the ``imported`` family (~30-60 s on 2 cores).
 import contextlib
 import io
 
+import pytest
+
 from dataset import generate
 from dataset.examples.ifc_houses import box_house
 from metrics.compare import main as compare
 from metrics.tables import read_csv_rows
 
 
+@pytest.mark.slow
 def test_methods_run_on_an_imported_ifc_scene(tmp_path):
     box_house(tmp_path / "house.ifc")
     data = tmp_path / "data"

@@ -125,6 +125,7 @@ def test_a_config_is_default_then_short_run_then_flags_then_set(methods, tmp_pat
     assert neural3d(*data, "--set", "neural3d.steps=7", "--set", "neural3d.steps=8").steps == 8
 
 
+@pytest.mark.slow
 def test_set_configs_are_what_the_comparison_records(tmp_path):
     data, results = make_benchmark(tmp_path)
     out = tmp_path / "out"

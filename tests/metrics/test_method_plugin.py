@@ -42,6 +42,7 @@ def _install_toy_package(root, monkeypatch):
     monkeypatch.syspath_prepend(str(root))
 
 
+@pytest.mark.slow
 def test_a_plugin_method_is_listed_and_compared(tiny_benchmark, tmp_path, monkeypatch):
     (tmp_path / "site").mkdir()
     _install_toy_package(tmp_path / "site", monkeypatch)
@@ -69,6 +70,7 @@ def test_a_plugin_method_is_listed_and_compared(tiny_benchmark, tmp_path, monkey
         sys.modules.pop("toy_wwr_plugin", None)
 
 
+@pytest.mark.slow
 def test_a_plugin_declares_its_own_option(tiny_benchmark, tmp_path, monkeypatch, capsys):
     """The toy's ``--toy-noise`` is in ``--help`` and sets its config, as ``--set`` does."""
     (tmp_path / "site").mkdir()

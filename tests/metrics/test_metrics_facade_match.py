@@ -83,6 +83,7 @@ def test_truth_without_outlines_goes_by_normal(l_shaped):
     assert [f.id for f in match.facades if not f.missing] == [1]
 
 
+@pytest.mark.slow
 def test_curved_wall_segments_merge_into_one_facade():
     """A measured cylinder mesh (several segments) against a 64-facet curved truth facade."""
     def sdf(p):

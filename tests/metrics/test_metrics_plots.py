@@ -15,6 +15,7 @@ ROWS = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("plot", [plot_wwr_scatter, plot_iou_per_building, "errors"])
 def test_plots_write_png_and_pdf(tmp_path, plot):
     if plot == "errors":

@@ -67,6 +67,7 @@ def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
         {"name": "pose", "severity": 1.0, "seed": 0}]}), record(degraded.config))
 
 
+@pytest.mark.slow
 def test_compare_degrade_runs_on_a_cached_copy_against_the_original_truth(tiny_benchmark,
                                                                           tmp_path) -> None:
     argv = ["--data", str(tiny_benchmark), "--methods", "2D-S", "--views", "ideal",

@@ -8,12 +8,14 @@ from __future__ import annotations
 import contextlib
 import io
 
+import pytest
 from test_blenderproc import write_blenderproc_output
 from test_buildnet3d import FIXTURE
 
 from dataset.generate import main as generate_main
 
 
+@pytest.mark.slow
 def test_metrics_compare_runs_every_method_on_imported_scenes(box_building, tmp_path):
     from metrics.compare import main as compare_main
     from metrics.report import read_building_errors_csv

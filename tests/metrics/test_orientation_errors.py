@@ -70,6 +70,7 @@ def test_summaries_pool_buildings_and_count_facades():
     assert table.keys[:4] == ("family", "method", "protocol", "orientation")
 
 
+@pytest.mark.slow
 def test_compare_writes_the_table_and_the_report_shows_it(tmp_path):
     """metrics_helpers' benchmark: 2D-S on sky_a estimates facade 1 (+x, E) at 0.30 against
     0.25 (+5 pp) and facade 2 (+y, N) at 0.25 (0 pp); its other results have no facades."""

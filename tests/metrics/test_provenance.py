@@ -114,6 +114,7 @@ def test_a_rerendered_scene_recomputes_its_results_and_stale_ones_can_be_kept(tm
     sys.modules.pop("toy_method_c")
 
 
+@pytest.mark.slow
 def test_a_result_cut_short_is_marked_in_every_table(tmp_path, capsys):
     data, results, out = tmp_path / "data", tmp_path / "results", tmp_path / "out"
     write_building(data / "sky_a" / "building.json", make_truth("sky_a"))
@@ -130,6 +131,7 @@ def test_a_result_cut_short_is_marked_in_every_table(tmp_path, capsys):
     assert "cut short" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_two_clean_comparisons_write_identical_tables(tiny_benchmark, tmp_path, monkeypatch):
     """Same command, same machine, clean caches: byte-identical tables (timing kept apart)."""
     argv = ["--data", str(tiny_benchmark), "--methods", "2D-S,2D-SS,neural3d",

@@ -23,6 +23,8 @@ from dataset.core.classes import SemanticClass
 from neural3d.extraction.measure import measure_semantic_mesh
 from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 
+pytestmark = pytest.mark.slow  # every test here measures fields sampled on dense grids
+
 HEIGHT_M, LEG_M = 6.0, 1.2
 WALL, ROOF, OTHER = int(SemanticClass.WALL), int(SemanticClass.ROOF), int(SemanticClass.OTHER)
 NO_CORNERS = MeasureConfig(stages=MeasureStages(concave_corner_fill=False))
@@ -78,6 +80,7 @@ def chamfered():
     return measure_semantic_mesh(v, f, lab, config=NO_CORNERS), measure_semantic_mesh(v, f, lab)
 
 
+@pytest.mark.slow
 def test_a_corner_the_field_filled_is_measured_as_the_sharp_l_it_stands_for(chamfered):
     truth_m2 = _facade_truth_m2(0.0)  # the building: the sharp L, 240 m²
     before, after = chamfered
@@ -108,6 +111,7 @@ def test_a_chamfer_as_built_is_counted_as_a_sharp_corner_the_stages_stated_bias(
     assert before.facade_area_m2 == pytest.approx(truth_m2, abs=1.0)
 
 
+@pytest.mark.slow
 def test_a_sharp_corner_from_a_perfect_field_is_left_where_it_is():
     """The sharp L meshed by marching cubes (0.15 m voxels) from its exact signed distance:
     the corner is rounded by under a voxel, and the stage moves the facade by under
@@ -131,6 +135,7 @@ def test_a_sharp_corner_from_a_perfect_field_is_left_where_it_is():
     assert len(_inner(on)) == 2
 
 
+@pytest.mark.slow
 def test_a_sharp_corner_and_a_convex_one_are_left_alone():
     v, f, lab = _l_prism(0.0)
     sharp = measure_semantic_mesh(v, f, lab)
@@ -139,6 +144,7 @@ def test_a_sharp_corner_and_a_convex_one_are_left_alone():
         measure_semantic_mesh(v, f, lab, config=NO_CORNERS).facade_area_m2, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_a_corner_further_than_the_longest_gap_is_not_filled():
     v, f, lab = _l_prism(2.0)  # legs of 2 m: longer than corner_max_gap_m (1.5 m)
     assert measure_semantic_mesh(v, f, lab).facade_area_m2 == pytest.approx(

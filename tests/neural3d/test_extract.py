@@ -83,6 +83,7 @@ def _box_truth():
 CONFIG = ExtractConfig(resolution=96, footprint_cell_m=0.1)
 
 
+@pytest.mark.slow
 def test_measure_field_on_an_analytic_field(scene_dir):
     field = AnalyticField(scene_dir)
     result, mesh = measure_field(field, CONFIG)
@@ -108,6 +109,7 @@ def test_measure_field_on_an_analytic_field(scene_dir):
     assert mesh.vertex_rgb.dtype == np.uint8 and mesh.vertex_rgb.shape == (len(mesh.vertices_m), 3)
 
 
+@pytest.mark.slow
 def test_evaluation_matches_the_own_facades_to_the_truth(scene_dir):
     result, _ = measure_field(AnalyticField(scene_dir), CONFIG)
     rows = facade_errors(result, _box_truth())
@@ -118,6 +120,7 @@ def test_evaluation_matches_the_own_facades_to_the_truth(scene_dir):
     assert all(r.facade_ape < 2.0 for r in rows)
 
 
+@pytest.mark.slow
 def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
     monkeypatch.setattr(neural3d.field.trained, "load_trained_field",
                         lambda run_dir, device, step=None: AnalyticField(scene_dir))
@@ -148,6 +151,7 @@ def test_bad_config():
         ExtractConfig(resolution=4)
 
 
+@pytest.mark.slow
 def test_extract_run_on_a_trained_run(box_building, tmp_path):
     """A few iterations of the tiny preset: the plumbing from checkpoint to files, not accuracy."""
     from neural3d_scene import write_ring_scene

@@ -37,6 +37,7 @@ def test_triangle_area_is_shared_by_vertex_classes():
     np.testing.assert_allclose(areas.sum(axis=1), [3.0, 1.0])
 
 
+@pytest.mark.slow
 def test_box_with_window_band(banded_box):
     m = measure_semantic_mesh(*banded_box)
     assert m.facade_area_m2 == pytest.approx(2 * (6 + 4) * 10, rel=0.01)
@@ -57,6 +58,7 @@ def test_box_with_window_band(banded_box):
                                [[3, 0, 5], [0, 2, 5], [-3, 0, 5], [0, -2, 5]], atol=0.1)
 
 
+@pytest.mark.slow
 def test_cylinder_curved_facade():
     def sdf(p):
         return cylinder_sdf(p, [1.0, -1.0], 5.0, 0.0, 10.0)
@@ -74,6 +76,7 @@ def test_cylinder_curved_facade():
     assert sum(fa.facade_area_m2 for fa in m.facades) == pytest.approx(m.facade_area_m2, rel=0.01)
 
 
+@pytest.mark.slow
 def test_l_prism_splits_parallel_walls():
     v, f, labels = _semantic_mesh(l_prism_sdf, [-1, -1, -1], [11, 13, 9], (2.0, 4.0), 0.1)
     m = measure_semantic_mesh(v, f, labels)
@@ -83,6 +86,7 @@ def test_l_prism_splits_parallel_walls():
     assert m.wwr == pytest.approx(2 / 8, abs=0.01)
 
 
+@pytest.mark.slow
 def test_grouping_config_and_ungrouped_area(banded_box):
     v, f, labels = banded_box
     group = group_facade_faces(v, f, labels)
@@ -139,6 +143,7 @@ def _recessed_box(voxel_size_m: float = 0.05, *, window_m: tuple[float, float] =
     return v, f, label_vertices(v, label)
 
 
+@pytest.mark.slow
 def test_projected_counts_recesses_and_underside_once():
     v, f, labels = _recessed_box()
     m = measure_semantic_mesh(v, f, labels)
@@ -156,6 +161,7 @@ def test_projected_counts_recesses_and_underside_once():
     assert every.facade_area_m2 > m.facade_area_m2 + 0.9 * 24.0
 
 
+@pytest.mark.slow
 def test_surfaces_inside_the_building_count_for_nothing():
     """A closed cavity inside the 6 x 4 x 10 m box (a blob a field may leave behind the
     windows): its 2 x (4 + 2) x 6 = 72 m² of walls are hidden from outside."""

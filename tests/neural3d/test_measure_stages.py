@@ -136,6 +136,7 @@ CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, off, knobs", CASES)
 def test_the_stages_give_the_one_functions_numbers(meshes, name, off, knobs):
     v, f, labels, p = meshes[name]

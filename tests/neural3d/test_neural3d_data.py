@@ -21,6 +21,7 @@ def scene(box_building, tmp_path_factory):
                                        size_px=24, n_train=8, n_eval=2))
 
 
+@pytest.mark.slow
 def test_rays_reach_the_depth_points(scene):
     frames = load_frames(scene, "train", with_depth=True)
     norm = scene_normalisation(frames, background_class(scene), margin=0.1)
@@ -47,6 +48,7 @@ def test_image_scale_resizes_images_and_intrinsics(scene):
     assert half[0].intrinsics.width == 12
 
 
+@pytest.mark.slow
 def test_normalisation_box_contains_the_building(scene):
     frames = load_frames(scene, "train")
     norm = scene_normalisation(frames, 0, margin=0.0)

@@ -20,6 +20,7 @@ def unit_dirs(n, seed=0):
     return d / d.norm(dim=1, keepdim=True)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backbone", ["mlp", "grid"])
 @pytest.mark.parametrize("radius", [0.5, 0.8])
 def test_geometric_init_is_a_sphere_of_the_configured_radius(backbone, radius):
@@ -35,6 +36,7 @@ def test_geometric_init_is_a_sphere_of_the_configured_radius(backbone, radius):
     assert (inside < 0).float().mean() > 0.9 and (outside > 0).float().mean() > 0.9
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backbone", ["mlp", "grid"])
 def test_finite_difference_normals_match_analytic(backbone):
     f = make(backbone)
@@ -47,6 +49,7 @@ def test_finite_difference_normals_match_analytic(backbone):
     assert torch.allclose(g_a, g_f, atol=0.02), (g_a - g_f).abs().max()
 
 
+@pytest.mark.slow
 def test_analytic_gradient_keeps_graph_for_eikonal():
     f = make("grid")
     x = unit_dirs(50) * 0.5
@@ -55,6 +58,7 @@ def test_analytic_gradient_keeps_graph_for_eikonal():
     assert f.sdf_net.mlp.linears[0].weight.grad.abs().sum() > 0
 
 
+@pytest.mark.slow
 def test_heads_shapes_and_ranges():
     f = make("grid")
     x, d = unit_dirs(10) * 0.4, unit_dirs(10, seed=1)
@@ -77,6 +81,7 @@ def test_skip_needs_a_wider_hidden_layer():
         SemanticSDF(FieldConfig(backbone="mlp", mlp_hidden=32, mlp_skip=2), 6, *BOX)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backbone", ["mlp", "grid"])
 def test_input_encoding_keeps_x_first_and_has_a_schedule(backbone):
     enc = make(backbone).sdf_net.encoding

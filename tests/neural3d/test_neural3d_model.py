@@ -1,6 +1,7 @@
 """Wiring of rays through the field: misses see only the environment; shapes."""
 
 import numpy as np
+import pytest
 import torch
 
 from neural3d.config import preset_config
@@ -8,6 +9,7 @@ from neural3d.field.fields import SemanticSDF
 from neural3d.rendering.model import cos_anneal_ratio, render_rays
 
 
+@pytest.mark.slow
 def test_render_rays_hits_and_misses():
     config = preset_config("tiny")
     torch.manual_seed(0)

@@ -79,6 +79,7 @@ def test_occupancy_marks_the_surface_shell_only(grid):
     assert grid.fraction_occupied() < 0.5  # measured 0.43: a shell 3-4 cells thick
 
 
+@pytest.mark.slow
 def test_skipping_renders_dense_depth_and_accumulation_with_fewer_samples(grid):
     origins, dirs = orbit_rays()
     depth_d, acc_d, evals_d = render(origins, dirs, 128, 64)

@@ -34,6 +34,7 @@ def config_of(steps):
     return replace(preset_config("tiny"), iterations=steps, eval_every=10, checkpoint_every=10)
 
 
+@pytest.mark.slow
 def test_prior_run_tells_finished_partial_and_other(scene, tmp_path):
     torch.set_num_threads(1)
     config = config_of(STEPS)
@@ -55,6 +56,7 @@ def test_prior_run_tells_finished_partial_and_other(scene, tmp_path):
     assert prior_run(run, expected, STEPS) == "none"
 
 
+@pytest.mark.slow
 def test_second_run_reuses_the_training_and_measures_the_same(scene, tmp_path):
     read = read_method_input(scene)
     first = run_neural3d(read, "train", BUDGET, artefacts_dir=tmp_path)
@@ -71,6 +73,7 @@ def test_second_run_reuses_the_training_and_measures_the_same(scene, tmp_path):
     assert second.wall_time_s >= float(state["train_s"])  # the stored training is counted
 
 
+@pytest.mark.slow
 def test_a_partial_run_is_resumed_to_the_budget(scene, tmp_path):
     torch.set_num_threads(BUDGET.threads)
     half = config_of(STEPS // 2)

@@ -29,6 +29,7 @@ def views(n=16, size=64):
     return [k] * n, poses, masks
 
 
+@pytest.mark.slow
 def test_hull_box_is_tight_around_the_box():
     ks, poses, masks = views()
     lo, hi = visual_hull_box_m(ks, poses, masks, margin=0.0)
@@ -37,6 +38,7 @@ def test_hull_box_is_tight_around_the_box():
     assert np.all(lo >= LO - 1.5) and np.all(hi <= HI + 2.0), (lo, hi)
 
 
+@pytest.mark.slow
 def test_margin_grows_the_box():
     ks, poses, masks = views()
     lo0, hi0 = visual_hull_box_m(ks, poses, masks, margin=0.0)

@@ -47,6 +47,7 @@ def box_surface_points(n, seed=0):
     return torch.tensor(np.stack([x, y, z], 1), dtype=torch.float32)
 
 
+@pytest.mark.slow
 def test_short_training_lowers_every_loss(short_run):
     with (short_run / "log.csv").open() as f:
         rows = list(csv.DictReader(f))
@@ -60,6 +61,7 @@ def test_short_training_lowers_every_loss(short_run):
     assert evals[-1]["semantic_accuracy"] > 0.8
 
 
+@pytest.mark.slow
 def test_zero_level_set_fits_the_box(short_run):
     field = load_trained_field(short_run, device=CPU)
     sdf = field.sdf_m(box_surface_points(1000))
@@ -96,12 +98,14 @@ def _interrupted_and_resumed(scene, tmp_path):
             read_checkpoint(resumed / "checkpoint.pt", CPU))
 
 
+@pytest.mark.slow
 def test_interrupted_training_resumes_from_its_checkpoint(scene, tmp_path, one_thread):
     a, b = _interrupted_and_resumed(scene, tmp_path)
     assert a["step"] == b["step"] == 6
     assert a["field"].keys() == b["field"].keys()
 
 
+@pytest.mark.slow
 def test_resume_matches_uninterrupted_run(scene, tmp_path, one_thread):
     a, b = _interrupted_and_resumed(scene, tmp_path)
     for key, value in a["field"].items():
@@ -109,6 +113,7 @@ def test_resume_matches_uninterrupted_run(scene, tmp_path, one_thread):
         assert torch.allclose(value, b["field"][key], atol=1e-6), (key, diff)
 
 
+@pytest.mark.slow
 def test_callback_stops_early(scene, tmp_path):
     config = replace(preset_config("tiny"), iterations=50, rays_per_batch=16, eval_every=2)
     seen = []
@@ -159,6 +164,7 @@ def test_cli_reports_errors_in_one_line(tmp_path, capsys):
         assert "CUDA is not available" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
     tiny = preset_config("tiny")
     model = replace(tiny.model, backbone="mlp", mlp_hidden=64, mlp_layers=4, mlp_skip=2,
@@ -178,6 +184,7 @@ def test_train_step_is_the_only_training_step():
         assert copy not in bench, f"bench/neural3d.py has its own {copy}"
 
 
+@pytest.mark.slow
 def test_sigterm_saves_a_checkpoint_like_ctrl_c(scene, tmp_path):
     """The CLI run is killed with SIGTERM mid-training; its checkpoint is there to resume."""
     import os
@@ -203,6 +210,7 @@ def test_sigterm_saves_a_checkpoint_like_ctrl_c(scene, tmp_path):
     assert read_checkpoint(tmp_path / "box" / "checkpoint.pt", CPU)["step"] >= 20
 
 
+@pytest.mark.slow
 def test_training_with_occupancy_grid_refreshes_and_checkpoints_it(scene, tmp_path):
     config = replace(preset_config("tiny"), iterations=6, rays_per_batch=32, eval_every=6,
                      checkpoint_every=6, occupancy_resolution=16, occupancy_start=2,
@@ -227,6 +235,7 @@ def test_update_ema_is_the_exponential_average():
     assert torch.allclose(average.weight, torch.full((1, 2), 0.875))  # 1 - 0.5^3
 
 
+@pytest.mark.slow
 def test_training_with_ema_checkpoints_and_loads_the_averaged_field(scene, tmp_path):
     config = replace(preset_config("tiny"), iterations=4, rays_per_batch=16, eval_every=4,
                      checkpoint_every=4, ema_decay=0.5)
@@ -242,6 +251,7 @@ def test_training_with_ema_checkpoints_and_loads_the_averaged_field(scene, tmp_p
     assert seen == [state["ema"]["log_inv_s"].item()]  # the callback measured the average
 
 
+@pytest.mark.slow
 def test_each_evaluation_keeps_a_snapshot_of_the_measured_field(short_run):
     from neural3d.field.checkpoint import snapshot_path, snapshot_steps
 

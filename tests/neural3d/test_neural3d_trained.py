@@ -21,6 +21,7 @@ def field(box_building, tmp_path_factory):
     return load_trained_field(train(scene, config, root / "runs", device=CPU), device=CPU)
 
 
+@pytest.mark.slow
 def test_world_metres_wrap_the_normalisation(field):
     p = torch.tensor([[0.0, 0.0, 4.5], [12.0, -3.0, 2.0]])
     unit = field.normalisation.unit_from_world(p.double()).float()

@@ -119,6 +119,7 @@ def test_front_seen_faces_are_the_facade_a_camera_in_front_meets_first():
     assert probe.shape == (100, 60) and probe.seen.sum() == 6000 - 400  # the hole's 4 m²
 
 
+@pytest.mark.slow
 def test_faces_the_hemisphere_test_drops_but_the_front_sees_count():
     """Square slot windows (0.4 m, recessed 0.38 m) in a box (tests/neural3d/test_measure.py): few
     hemisphere rays leave a slot, and the test drops part of the panes and reveals (window

@@ -60,6 +60,7 @@ def assert_one_error(err: str, pattern: str) -> None:
 
 # --- a damaged scene: both baselines and neural3d refuse it in one line ----------------------
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", sorted(SCENE_EDITS))
 def test_damaged_scene_is_refused_by_2dss(case, scene, capsys):
     edit, pattern = SCENE_EDITS[case]
@@ -354,6 +355,7 @@ def test_compare_refuses_bad_values(argv, pattern, scene, tmp_path, capsys):
     assert not (tmp_path / "bench-compare").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("damage, expect", [
     ("result", "corrupt result file"),
     ("building", "building.json"),

@@ -9,6 +9,7 @@ import ast
 from functools import cache
 from pathlib import Path
 
+import pytest
 from paths import REPO_ROOT
 
 ROOT = REPO_ROOT
@@ -107,6 +108,7 @@ def helper_axis(node) -> bool:
         and node.value.func.attr == "where")
 
 
+@pytest.mark.slow
 def test_protocol_and_split_names_are_spelled_only_in_dataset_protocols():
     spelled = []
     for path in sources():
@@ -116,6 +118,7 @@ def test_protocol_and_split_names_are_spelled_only_in_dataset_protocols():
     assert spelled and all(s.startswith("dataset/core/protocols.py:") for s in spelled), spelled
 
 
+@pytest.mark.slow
 def test_the_class_palette_is_defined_once():
     # the class colours written out, e.g. (40, 110, 230), and the colour of unknown ids
     colours = sorted(set(where(constant_tuple(40, 110, 230)) + where(constant_tuple(200, 200, 200))
@@ -123,6 +126,7 @@ def test_the_class_palette_is_defined_once():
     assert len(colours) == 2 and all(c.startswith("dataset/core/classes.py:") for c in colours)
 
 
+@pytest.mark.slow
 def test_each_default_is_assigned_once():
     for name in ("MERGE_DECIMALS", "DEFAULT_CHUNK_POINTS", "scene_name", "CLASS_RGB",
                  "UNKNOWN_CLASS_RGB", "Split", "SPLITS", "PROTOCOLS"):

@@ -102,6 +102,7 @@ def test_no_sub_package_imports_one_later_in_its_flow(package):
     assert wrong == []
 
 
+@pytest.mark.slow
 def test_no_module_imports_itself_in_a_circle():
     graph = {module_name(p): imported_modules(p) for package in LAYER
              for p in (ROOT / package).rglob("*.py")}

@@ -56,6 +56,7 @@ def _check_interrupted(code: int, err: str, sig: int, message: str) -> None:
 SIGNAL_CASES = [(sig, seed) for sig in (signal.SIGINT, signal.SIGKILL) for seed in (0,)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
 def test_generate_interrupted_then_rerun(sig, seed, tmp_path):
     out = tmp_path / "out"
@@ -73,6 +74,7 @@ def test_generate_interrupted_then_rerun(sig, seed, tmp_path):
     assert not list(out.glob(".*.partial"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
 def test_train_interrupted_then_resumed(sig, seed, clean_scene, tmp_path):
     from neural3d.field.checkpoint import read_checkpoint
@@ -95,6 +97,7 @@ def test_train_interrupted_then_resumed(sig, seed, clean_scene, tmp_path):
     assert (run / "log.csv").read_text().splitlines()[-1].startswith("20,")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, seed", SIGNAL_CASES)
 def test_compare_interrupted_then_rerun(sig, seed, clean_scene, tmp_path):
     bench, results = tmp_path / "bench", tmp_path / "results"

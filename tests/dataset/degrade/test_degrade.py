@@ -125,6 +125,7 @@ def test_pose_noise_moves_back_projected_points_by_the_stated_amount() -> None:
     assert np.array_equal(pose_noise(pose, 0.0, np.random.default_rng(0)), pose)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", DEGRADATIONS)
 def test_severity_zero_leaves_every_input_bit_identical(box_scene: Path, tmp_path: Path,
                                                         name: str) -> None:
@@ -138,6 +139,7 @@ def test_severity_zero_leaves_every_input_bit_identical(box_scene: Path, tmp_pat
         assert np.array_equal(a.world_from_camera, b.world_from_camera)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("text", ["occluders:2", "mask_noise:2", "depth_noise:2", "pose:0.5"])
 def test_degradations_are_seeded_and_never_touch_the_truth(box_scene: Path, tmp_path: Path,
                                                            text: str) -> None:
@@ -163,6 +165,7 @@ def test_degradations_are_seeded_and_never_touch_the_truth(box_scene: Path, tmp_
     assert not [f for f in changed if f.startswith("instances/")]
 
 
+@pytest.mark.slow
 def test_occluders_cover_facade_pixels_and_label_them_background(box_scene: Path,
                                                                  tmp_path: Path) -> None:
     out = degrade_scene(box_scene, tmp_path, parse_specs("occluders:3"))

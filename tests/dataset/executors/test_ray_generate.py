@@ -19,6 +19,7 @@ def _files(root):
     return {p.relative_to(root).as_posix(): p.read_bytes() for p in root.rglob("*") if p.is_file()}
 
 
+@pytest.mark.slow
 def test_ray_renders_the_tiny_preset_byte_identical_to_the_local_run(tiny_benchmark, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)

@@ -58,6 +58,7 @@ def test_reads_version_crs_and_kinds():
     assert {_fixture(i) for i in IDS} <= set(citygml_files(FIXTURES))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("building_id", IDS)
 def test_mesh_holds_every_polygon_area(imported, building_id):
     """Each class's triangle area equals the sum of its polygons' areas (to 0.1 %); windows

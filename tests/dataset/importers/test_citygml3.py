@@ -27,6 +27,7 @@ def test_both_versions_read_the_same_exterior():
     assert any(p.kind == "interior" for p in m3.buildings[0].polygons)  # rooms, furniture
 
 
+@pytest.mark.slow
 def test_both_versions_import_to_the_same_truth():
     (b2,), (b3,) = import_citygml(V2), import_citygml(V3)
     t2, t3 = b2.truth, b3.truth

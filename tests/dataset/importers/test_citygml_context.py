@@ -107,6 +107,7 @@ def test_a_neighbour_occludes_pixels_and_labels_them_background(street):
     assert np.array_equal(context.labels[same & facade], alone.labels[same & facade])
 
 
+@pytest.mark.slow
 def test_generate_with_context_keeps_the_truth(street, tmp_path):
     _, path = street
     tiny = ["--resolution", "32", "--views", "2", "--quiet"]
@@ -125,6 +126,7 @@ def test_generate_with_context_keeps_the_truth(street, tmp_path):
     assert config["generator"]["config"]["context"] is True
 
 
+@pytest.mark.slow
 def test_real_street_neighbours_and_types():
     """On the shipped street: 4018207 shares both side walls (terraced), 4018149b's loggias
     hide a fifth of its front (with balconies), 4018133 stands free of the set's buildings."""

@@ -33,6 +33,7 @@ def _totals(checks, attr: str) -> tuple[float, float]:
     return window, gross
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", [FIXTURES / "4018259.xml.xz", FIXTURES / "4018133.xml.xz",
                                   FIXTURES / "4018149b.xml.xz",
                                   # a door whose region GEOS's floating overlay lost (-4.4 %)

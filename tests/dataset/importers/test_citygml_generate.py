@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from paths import FIXTURES
 
 from dataset.core.truth import read_building
@@ -16,6 +17,7 @@ FIXTURES = FIXTURES / "citygml"
 TINY = ["--resolution", "48", "--views", "2", "--quiet"]
 
 
+@pytest.mark.slow
 def test_generate_citygml_writes_one_scene_per_building(tmp_path):
     out = tmp_path / "scenes"
     assert main(["--citygml", str(FIXTURES / "4018259.xml.xz"), "--out", str(out), *TINY]) == 0
@@ -57,6 +59,7 @@ def test_lod3_preset_lists_the_shipped_buildings():
     assert all(r.family == "citygml" for r in recipes)
 
 
+@pytest.mark.slow
 def test_lod3_recipe_builds_the_same_building_as_the_fixture():
     """Same file, same facades and areas; the preset's building also has the neighbours of
     the shipped city model (the fixture imported alone has none)."""
@@ -72,6 +75,7 @@ def test_lod3_recipe_builds_the_same_building_as_the_fixture():
     assert alone.truth.extra["warnings"]["texture image missing: procedural look"] > 0
 
 
+@pytest.mark.slow
 def test_make_lod3_copies_files_with_windows_and_writes_the_manifest(tmp_path):
     """The maker of the shipped folder, on a miniature clone: two buildings with windows, one
     file without any building window (a neighbour alone: the OGC house's 2.0 file has two,

@@ -54,6 +54,7 @@ def _check_truth(building, expected):
     assert not Raycaster(mesh).contains(outside).any()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(HOUSES))
 def test_ifc_houses_match_their_areas_by_hand(houses, name):
     expected, path = houses[name]
@@ -66,6 +67,7 @@ def test_ifc_houses_match_their_areas_by_hand(houses, name):
         assert window["measured_area_m2"] == pytest.approx(window["declared_area_m2"], rel=0.01)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["box_mm", "l_shaped", "crawl_space", "curtain_wall"])
 def test_the_same_houses_as_one_multi_body_ply(houses, tmp_path, name):
     expected, path = houses[name]
@@ -133,6 +135,7 @@ def test_classes_of_curtain_wall_parts_and_roof_slabs(houses):
                        "IfcWall": {SemanticClass.WALL}, "IfcSlab": {SemanticClass.ROOF}}
 
 
+@pytest.mark.slow
 def test_generate_ifc_twice_gives_identical_files(houses, tmp_path, capsys):
     path = houses["box_mm"][1]
     for out in ("a", "b"):

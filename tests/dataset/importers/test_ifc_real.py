@@ -45,6 +45,7 @@ def _check_against_independent_measures(model, building, *, footprint_m2: float)
     assert t.footprint_area_m2 == pytest.approx(footprint_m2, rel=0.01)
 
 
+@pytest.mark.slow
 def test_ifcopenshell_house_windows_made_of_parts(tmp_path_factory):
     """IfcOpenHouse: each IfcWindow is an aggregate of four members and a glass plate
     (no geometry of its own) declaring 1.86 x 1.60 m. Measured: windows 14.58 m² v 14.88
@@ -57,6 +58,7 @@ def test_ifcopenshell_house_windows_made_of_parts(tmp_path_factory):
     _check_against_independent_measures(model, building, footprint_m2=53.4)
 
 
+@pytest.mark.slow
 def test_revit_duplex_with_a_foundation_storey(tmp_path_factory):
     """Revit 2011's duplex (refused before: 'the section at z = 0.050 m holds no solid'):
     the ground is storey 'Level 1' at 0.00, the foundation storey 'T/FDN' at -1.25 m is

@@ -95,6 +95,7 @@ def test_bad_config_and_names_are_refused(tmp_path):
         generate_scene(make_box_building(), tmp_path, SMALL, seed=0, name="../escape")
 
 
+@pytest.mark.slow
 def test_worker_processes_write_the_same_files(tmp_path):
     box = make_box_building()
     one = generate_scene(box, tmp_path / "one", SMALL, seed=5, progress=False)
