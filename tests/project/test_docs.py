@@ -1,5 +1,6 @@
 """The docs name only what exists: every project file path and every dotted name in README.md
-and docs/*.md resolves (docs/decisions.md is dated history and keeps the names of its day)."""
+and docs/*.md resolves (docs/decisions.md is dated history and keeps the names of its day, as
+do the files under docs/measurements/, which the glob below does not reach)."""
 
 import ast
 import re
