@@ -23,10 +23,11 @@ METHOD_2DS = Method(
     name="2D-S", inputs=("semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
     config_type=Wwr2dsConfig, run=run_2ds, packages=("baselines",), libraries=LIBRARIES,
     description="per-view window/facade pixel ratio of the semantic mask (Szczesniak et al.)",
+    paper_name="2D-S",
 )
 METHOD_2DSS = Method(
     name="2D-SS", inputs=("rgb", "semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
     config_type=Wwr2dssConfig, run=run_2dss, packages=("baselines",), libraries=LIBRARIES,
     description="facade plane by RANSAC, rectified facade, WWR in the rectified mask",
-    debug_images=debug_images_2dss,
+    debug_images=debug_images_2dss, paper_name="2D-SS",
 )

@@ -30,10 +30,13 @@ import json
 import statistics
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
-# Run as a script, this file's folder is sys.path[0]: put the repository root there instead.
-sys.path[0] = str(Path(__file__).resolve().parent.parent)
+# Run as a script, this file's folder is sys.path[0]: put the repository root there instead
+# (imported as bench.neural3d_stages, the path is the importer's and stays as it is).
+if not __package__:
+    sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 
@@ -83,19 +86,50 @@ def measure_building(run_dir: Path, extract: ExtractConfig,
     tic = time.perf_counter()
     mesh = semantic_mesh_of_field(field, extract, device)
     row: dict = {"scene": run_dir.name, "family": truth.type if truth else None,
-                 "mesh": mesh_fingerprint(mesh), "mesh_s": round(time.perf_counter() - tic, 1),
-                 "sets": {}}
+                 "mesh": mesh_fingerprint(mesh), "mesh_s": round(time.perf_counter() - tic, 1)}
+    row["sets"] = measure_sets(field, mesh, truth, extract, sets, device=device)
+    return row
+
+
+def measure_sets(field, mesh: SemanticMesh, truth, extract: ExtractConfig,
+                 sets: dict[str, tuple[str, ...]], *, device: torch.device) -> dict:
+    """Per stage set (label -> stages off): the measured part of the result of ``mesh``
+    (:func:`neural3d.extract.measure_mesh` of ``field``, a ``TrainedField`` or anything
+    with its interface), its errors against ``truth`` and the seconds it took."""
+    out = {}
     for label, off in sets.items():
         tic = time.perf_counter()
         result = measure_mesh(field, mesh, without_stages(extract, *off), device=device)
         errors = building_errors(result, truth)
-        row["sets"][label] = {
+        out[label] = {
             "result": json.loads(json.dumps({k: result.to_json_dict()[k] for k in MEASURED})),
             "errors": {k: getattr(errors, k) for k in ERRORS},
             "measure_s": round(time.perf_counter() - tic, 1)}
-        print(f"  {run_dir.name} {label}: {row['sets'][label]['errors']}", file=sys.stderr,
+        print(f"  {field.scene_name} {label}: {out[label]['errors']}", file=sys.stderr,
               flush=True)
-    return row
+    return out
+
+
+@dataclass(frozen=True)
+class Column:
+    """A column of the tables: ``header``, the figure ``entry[section][key]`` of a stage
+    set's entry (``entry[key]`` when ``section`` is None), printed with ``digits``."""
+
+    header: str
+    section: str | None
+    key: str
+    digits: int
+
+
+ERROR_COLUMNS = (Column("WWR %", "errors", "wwr_ape", 2),
+                 Column("window %", "errors", "window_ape", 2),
+                 Column("facade %", "errors", "facade_ape", 2),
+                 Column("IoU", "errors", "footprint_iou", 3))
+SECONDS = Column("measure s", None, "measure_s", 1)
+
+
+def _value(entry: dict, column: Column) -> float | None:
+    return entry[column.key] if column.section is None else entry[column.section][column.key]
 
 
 def _cell(values: list[float | None], digits: int) -> str:
@@ -103,29 +137,32 @@ def _cell(values: list[float | None], digits: int) -> str:
     return f"{statistics.mean(known):.{digits}f}" if known else "-"
 
 
-def markdown(buildings: list[dict]) -> str:
-    """Per family (mean) and per building, for each stage set: WWR / window / facade APE %
-    and footprint IoU."""
+def markdown(buildings: list[dict], columns: tuple[Column, ...] = ERROR_COLUMNS) -> str:
+    """Per family (mean) and per building, for each stage set: the ``columns`` (by default
+    WWR / window / facade APE % and footprint IoU; per building also the seconds)."""
     labels = list(buildings[0]["sets"])
     families = sorted({b["family"] for b in buildings}, key=str)
-    lines = ["| stages | family (buildings) | WWR % | window % | facade % | IoU |",
-             "|---|---|---|---|---|---|"]
+    lines = [_row("stages", "family (buildings)", [c.header for c in columns]),
+             "|---" * (2 + len(columns)) + "|"]
     for label in labels:
         for family in [*families, None] if len(families) > 1 else families:
             members = [b for b in buildings if family is None or b["family"] == family]
-            errors = [b["sets"][label]["errors"] for b in members]
+            entries = [b["sets"][label] for b in members]
             name = "all" if family is None else family
-            lines.append(f"| {label} | {name} ({len(members)}) | " + " | ".join(
-                _cell([e[k] for e in errors], 3 if k == "footprint_iou" else 2)
-                for k in ERRORS) + " |")
-    lines += ["", "| stages | building | WWR % | window % | facade % | IoU | measure s |",
-              "|---|---|---|---|---|---|---|"]
+            lines.append(_row(label, f"{name} ({len(members)})", [
+                _cell([_value(e, c) for e in entries], c.digits) for c in columns]))
+    per_building = (*columns, SECONDS)
+    lines += ["", _row("stages", "building", [c.header for c in per_building]),
+              "|---" * (2 + len(per_building)) + "|"]
     for label in labels:
         for b in buildings:
-            e, s = b["sets"][label]["errors"], b["sets"][label]["measure_s"]
-            lines.append(f"| {label} | {b['scene']} | " + " | ".join(
-                _cell([e[k]], 3 if k == "footprint_iou" else 2) for k in ERRORS) + f" | {s} |")
+            lines.append(_row(label, b["scene"], [
+                _cell([_value(b["sets"][label], c)], c.digits) for c in per_building]))
     return "\n".join(lines)
+
+
+def _row(first: str, second: str, cells: list[str]) -> str:
+    return "| " + " | ".join([first, second, *cells]) + " |"
 
 
 def differences(saved: dict, buildings: list[dict]) -> tuple[list[str], int]:

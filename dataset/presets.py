@@ -45,7 +45,7 @@ PRESETS = ("paper", "tiny", "heldout", "lod3", "segtrain")
 _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 # Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
-# footprints); tests/test_presets.py checks that they stay small.
+# footprints); tests/dataset/test_presets.py checks that they stay small.
 _TINY_SKYSCRAPER_SEED = 38
 _TINY_L_SHAPED_SEED = 37
 # Seeds of the paper preset: from seeds 1000-1199 (2000-2199), those whose samples reach the

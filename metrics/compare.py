@@ -22,7 +22,7 @@ from __future__ import annotations
 import shutil
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
@@ -134,7 +134,7 @@ def compare(
         table2=replace(table2, notes=(*table2.notes, footer)),
         table3=replace(table3, notes=(*table3.notes, footer)),
         outcomes=tuple(outcomes),
-        more_tables=claims_tables(groups),
+        more_tables=claims_tables(groups, paper_names_of(specs)),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
     comment = f"produced by `{command}`; {footer}"
@@ -162,12 +162,19 @@ def compare(
     return comparison
 
 
-def claims_tables(groups: Sequence[GroupSummary]) -> tuple[Table, ...]:
+def paper_names_of(specs: Sequence[MethodSpec]) -> dict[str, str]:
+    """Each method's name -> its name in the BuildNet3D paper, for those the paper has."""
+    return {s.name: s.paper_name for s in specs if s.paper_name is not None}
+
+
+def claims_tables(groups: Sequence[GroupSummary],
+                  paper_names: Mapping[str, str]) -> tuple[Table, ...]:
     """Table 2 against the full and the visible facade truth, the seed-to-seed spread (when
     a method ran with several seeds) and ours beside the BuildNet3D paper's Tables 2 and 3
     (each only when it has a row)."""
     tables = (table2_visible_errors(groups), seed_spread_table(groups),
-              paper_table2_comparison(groups), paper_table3_comparison(groups))
+              paper_table2_comparison(groups, paper_names),
+              paper_table3_comparison(groups, paper_names))
     return tuple(t for t in tables if t is not None and t.rows)
 
 

@@ -73,10 +73,10 @@ def parse_compare_args(argv: Sequence[str] | None,
                         help="folder for tables, plots, provenance (default: <data>-compare)")
     parser.add_argument("--seeds", default="0",
                         help="comma-separated training seeds of the methods whose config has a "
-                        "seed (neural3d): one result per seed and building (seed k > 0 in "
-                        "<scene>__<method>__<protocol>__seed<k>.json); the tables average a "
-                        "building's seeds, then bootstrap over buildings, and report the "
-                        "seed-to-seed spread (default: 0)")
+                        "seed field (a trained method's): one result per seed and building "
+                        "(seed k > 0 in <scene>__<method>__<protocol>__seed<k>.json); the "
+                        "tables average a building's seeds, then bootstrap over buildings, "
+                        "and report the seed-to-seed spread (default: 0)")
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
                         help="compare on degraded inputs (truth unchanged): "

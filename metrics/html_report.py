@@ -44,10 +44,9 @@ from metrics.paper_tables import (
     PAPER_KEYS,
     PAPER_TABLE2_LABEL,
     PAPER_TABLE3_LABEL,
-    paper_table2,
-    paper_table3,
 )
 from metrics.report import PER_BUILDING_NAME, TABLE2_NAME, TABLE3_NAME, read_building_errors_csv
+from metrics.report_paper import PAPER_TABLE2_NAME, PAPER_TABLE3_NAME
 from metrics.tables import format_cell, read_csv_rows, read_summary
 
 REPORT_FILE = "report.html"
@@ -81,6 +80,8 @@ def build_report(out_dir: Path) -> str:
     provenance = json.loads((out_dir / "provenance.json").read_text())
     table2 = read_csv_rows((out_dir / f"{TABLE2_NAME}.csv").read_text())
     table3 = read_csv_rows((out_dir / f"{TABLE3_NAME}.csv").read_text())
+    paper2, paper3 = (_csv_rows_if_any(out_dir / f"{n}.csv")
+                      for n in (PAPER_TABLE2_NAME, PAPER_TABLE3_NAME))
     rows = read_building_errors_csv(out_dir / f"{PER_BUILDING_NAME}.csv")
     scenes = sorted({(r.family, r.scene) for r in rows}, key=lambda s: (family_rank(s[0]), s[1]))
     data = Path(provenance.get("data", ""))
@@ -90,8 +91,8 @@ def build_report(out_dir: Path) -> str:
                         for _, s in scenes)
     body = (
         f"<h1>envelope-bench comparison</h1><p>{esc(provenance.get('produced_by', ''))}</p>"
-        f'<div id="overview"><h2>Table 2: errors per family</h2>{table2_html(table2)}'
-        f"<h2>Table 3: footprint IoU</h2>{table3_html(table3)}"
+        f'<div id="overview"><h2>Table 2: errors per family</h2>{table2_html(table2, paper2)}'
+        f"<h2>Table 3: footprint IoU</h2>{table3_html(table3, paper3)}"
         f"{claims_sections(out_dir)}"
         f"<h2>Charts</h2>{errors_chart(table2)}{iou_chart(rows)}"
         f"{orientation_section(out_dir)}</div>"
@@ -108,28 +109,43 @@ def _summary(row: dict[str, str], key: str) -> Summary:
     return read_summary(row, key)
 
 
+def _csv_rows_if_any(path: Path) -> list[dict[str, str]]:
+    return read_csv_rows(path.read_text()) if path.is_file() else []
+
+
+def _by_row(rows: Sequence[dict[str, str]]) -> dict[tuple[str, str, str], dict[str, str]]:
+    return {(r["family"], r["method"], r["protocol"]): r for r in rows}
+
+
+# our Table 2 error key -> the column of the paper's figure in the paper comparison table
+_PAPER_COLUMN = {"wwr_ape": "paper_wwr_ape", "window_ape": "paper_window_ape",
+                 "facade_ape": "paper_wall_ape"}
+
+
 def _summary_cell(s: Summary | None, decimals: int, css: str = "") -> Cell:
     if s is None or s.mean is None:
         return format_cell(None, decimals), ""
     return format_cell(s, decimals), repr(s.mean)
 
 
-def table2_html(rows: Sequence[dict[str, str]]) -> str:
-    """Table 2 from its CSV rows, the paper's published errors (:mod:`metrics.paper_tables`)
-    beside ours."""
+def table2_html(rows: Sequence[dict[str, str]],
+                paper_rows: Sequence[dict[str, str]] = ()) -> str:
+    """Table 2 from its CSV rows, the paper's published errors beside ours (``paper_rows``:
+    the rows of the paper comparison table, :mod:`metrics.report_paper`)."""
+    paper = _by_row(paper_rows)
     columns = ["Family", "Method", "Views", "Buildings", "Failed"]
     for key, label in ERROR_COLUMNS:
-        paper = "Wall" if key == "facade_ape" else label.split(" (")[0]
-        columns += [label, f"{paper}, {PAPER_TABLE2_LABEL}"]
+        paper_label = "Wall" if key == "facade_ape" else label.split(" (")[0]
+        columns += [label, f"{paper_label}, {PAPER_TABLE2_LABEL}"]
     columns += ["Steps", "Marks"]
     cells = []
     for r in rows:
-        ref = paper_table2(r["family"], r["method"], r["protocol"])
+        ref = paper.get((r["family"], r["method"], r["protocol"]))
         row: list[Cell] = [(r[k], r[k]) for k in ("family", "method", "protocol", "buildings",
                                                    "failed")]
         for key, _ in ERROR_COLUMNS:
             row += [_summary_cell(_summary(r, key), 2),
-                    _summary_cell(ref[key] if ref else None, 2)]
+                    _summary_cell(_summary(ref, _PAPER_COLUMN[key]) if ref else None, 2)]
         row += [(r["steps"] or "–", r["steps"]), (r["marks"] or "", r["marks"])]
         cells.append(row)
     attrs = [{"family": r["family"], "method": r["method"], "protocol": r["protocol"]}
@@ -143,22 +159,28 @@ def table2_html(rows: Sequence[dict[str, str]]) -> str:
             + '<ul class="ref">' + "".join(f"<li>{esc(c)}</li>" for c in CAVEATS) + "</ul>")
 
 
-def table3_html(rows: Sequence[dict[str, str]]) -> str:
-    """Table 3 from its CSV rows, BuildNet3D's published IoU (:mod:`metrics.paper_tables`)
-    beside neural3d's."""
+def table3_html(rows: Sequence[dict[str, str]],
+                paper_rows: Sequence[dict[str, str]] = ()) -> str:
+    """Table 3 from its CSV rows, BuildNet3D's published IoU beside ours (``paper_rows``: the
+    rows of the paper comparison table, :mod:`metrics.report_paper`)."""
+    paper = _by_row(paper_rows)
     if not rows:
         return '<p class="muted">no method estimates a footprint</p>'
     columns = ["Family", "Method", "Views", "Buildings", "Failed", "Footprint IoU",
                f"IoU, {PAPER_TABLE3_LABEL}", "Steps", "Marks"]
     cells = [[(r[k], r[k]) for k in ("family", "method", "protocol", "buildings", "failed")]
              + [_summary_cell(_summary(r, "footprint_iou"), 3),
-                _summary_cell(paper_table3(r["family"], r["method"], r["protocol"]), 3),
+                _summary_cell(_paper_iou(paper.get((r["family"], r["method"], r["protocol"]))), 3),
                 (r["steps"] or "–", r["steps"]), (r["marks"] or "", r["marks"])] for r in rows]
     attrs = [{"family": r["family"], "method": r["method"], "protocol": r["protocol"]}
              for r in rows]
     return (sortable_table("table3", columns, cells, attrs)
             + f'<p class="ref">{esc(PAPER_TABLE3_LABEL)}: BuildNet3D\'s mean over its four '
               "buildings of each type (no std published).</p>")
+
+
+def _paper_iou(row: dict[str, str] | None) -> Summary | None:
+    return None if row is None else _summary(row, "paper_footprint_iou")
 
 
 def errors_chart(rows: Sequence[dict[str, str]]) -> str:

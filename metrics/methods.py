@@ -93,7 +93,8 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
                       resources=TaskResources(cpus=cpus, gpus=gpus),
                       artefacts_dir=artefacts_dir, code=("dataset", *method.packages),
                       libraries=method.libraries, mesh_file=method.mesh_file,
-                      heavy=method.heavy, debug_images=debug_images, seed=seed)
+                      heavy=method.heavy, debug_images=debug_images, seed=seed,
+                      paper_name=method.paper_name)
 
 
 def _run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,

@@ -7,7 +7,7 @@ and the notes say what differs in a like-for-like reading.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from metrics.aggregate import GroupSummary
 from metrics.paper_tables import (
@@ -23,11 +23,13 @@ PAPER_TABLE2_NAME = "paper_table2"
 PAPER_TABLE3_NAME = "paper_table3"
 
 
-def paper_table2_comparison(groups: Sequence[GroupSummary]) -> Table:
-    """Our errors beside the paper's Table 2, for every group the paper has a row for."""
+def paper_table2_comparison(groups: Sequence[GroupSummary],
+                            paper_names: Mapping[str, str]) -> Table:
+    """Our errors beside the paper's Table 2, for every group the paper has a row for
+    (``paper_names``: our method's name -> its name in the paper)."""
     rows = []
     for g in groups:
-        paper = paper_table2(g.family, g.method, g.protocol)
+        paper = paper_table2(g.family, paper_names.get(g.method), g.protocol)
         if paper is not None:
             rows.append((g.family, g.method, g.protocol, g.buildings, g.steps,
                          g.wwr_ape, paper["wwr_ape"], g.window_ape, paper["window_ape"],
@@ -45,11 +47,13 @@ def paper_table2_comparison(groups: Sequence[GroupSummary]) -> Table:
     )
 
 
-def paper_table3_comparison(groups: Sequence[GroupSummary]) -> Table:
-    """Our footprint IoU beside the paper's Table 3 (BuildNet3D's rows only)."""
+def paper_table3_comparison(groups: Sequence[GroupSummary],
+                            paper_names: Mapping[str, str]) -> Table:
+    """Our footprint IoU beside the paper's Table 3 (BuildNet3D's rows only; ``paper_names``:
+    our method's name -> its name in the paper)."""
     rows = []
     for g in groups:
-        paper = paper_table3(g.family, g.method, g.protocol)
+        paper = paper_table3(g.family, paper_names.get(g.method), g.protocol)
         if paper is not None:
             rows.append((g.family, g.method, g.protocol, g.buildings, g.steps, g.footprint_iou,
                          paper))

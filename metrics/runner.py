@@ -63,6 +63,7 @@ class MethodSpec:
     each result's provenance record, so changing them recomputes the results.
     ``seed``: the training seed of a method whose config has one (neural3d); specs
     that differ only by it keep their results side by side (``__seed<k>`` files).
+    ``paper_name``: the method's name in the BuildNet3D paper's tables, if it has one.
     """
 
     name: str
@@ -78,6 +79,7 @@ class MethodSpec:
     heavy: bool = False
     debug_images: Callable[[Path, str, Path], None] | None = None
     seed: int | None = None
+    paper_name: str | None = None
 
 
 @dataclass(frozen=True)

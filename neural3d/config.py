@@ -77,7 +77,8 @@ class TrainConfig:
     occupancy_margin_cells: float = 1.0  # |sdf| margin beyond the half diagonal, in cells
     # weight averaging: the measured field is an exponential moving average of the trained
     # one (decay per step; 0 = off); evaluations, callbacks and load_trained_field use it.
-    # On in fast: the late checks' WWR spread fell from 5-10 points to ~1 (docs/decisions.md)
+    # On in fast: the late checks' WWR spread fell from 5-10 points to ~1 (docs/decisions.md,
+    # 2026-11-25 "weight averaging on"; docs/measurements/neural3d-paper-preset.md)
     ema_decay: float = 0.995
     image_scale: float = 1.0  # images are resized by this factor on load
     scene_box_margin: float = 0.1  # fraction of the visual-hull box added on each side

@@ -77,8 +77,8 @@ OPTIONS = (
 )
 # The built-in default comparison (tiny benchmark) and the robustness study: the smallest
 # step budget measured with every building within WWR error 5 % and footprint IoU 0.96
-# (docs/decisions.md), marching cubes at 128 and one eval frame (rendering the preset's
-# four costs about a minute of CPU per building).
+# (docs/decisions.md, 2026-11-24 "neural3d default budget"), marching cubes at 128 and one
+# eval frame (rendering the preset's four costs about a minute of CPU per building).
 SHORT_RUN = {"steps": 2000, "resolution": 128, "eval_frames": 1}
 
 
@@ -186,5 +186,5 @@ METHOD_NEURAL3D = Method(
                 "measured on its mesh (cpu or gpu: --device)",
     record_config=record_config, reserve=reserve, artefacts=RUNS_FOLDER,
     mesh_file=f"{EXTRACT_FOLDER}/mesh.ply", heavy=True,
-    options=OPTIONS, short_run=SHORT_RUN, check_config=check_budget,
+    options=OPTIONS, short_run=SHORT_RUN, check_config=check_budget, paper_name="BuildNet3D",
 )

@@ -13,9 +13,10 @@ from __future__ import annotations
 import gzip
 import json
 from functools import cache
-from pathlib import Path
 
-SCHEMA = Path(__file__).parent / "fixtures" / "cityjson" / "cityjson-2.0.min.schema.json.gz"
+from paths import FIXTURES
+
+SCHEMA = FIXTURES / "cityjson" / "cityjson-2.0.min.schema.json.gz"
 ROOT_PROPERTIES = ("type", "version", "extensions", "transform", "metadata", "CityObjects",
                    "vertices", "appearance", "geometry-templates")
 

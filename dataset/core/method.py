@@ -13,7 +13,7 @@ The truth is out of a method's reach: ``scene`` is a
 and semantic images the method declares in ``inputs``), never the
 :class:`~dataset.core.scene_record.Scene` with its ``building.json``; metrics reads the
 truth itself. A method's results must not change when ``building.json``, ``mesh.ply`` or
-the facade-id images are removed (``tests/test_truth_blind.py`` checks the built-in ones).
+the facade-id images are removed (``tests/metrics/test_truth_blind.py`` checks the built-in ones).
 
 Another package adds a method without touching this repository by exposing a
 :class:`Method` (or a zero-argument callable returning one) under the entry
@@ -68,7 +68,9 @@ class Method:
     provenance). ``packages``: importable packages whose source its results
     depend on, besides ``dataset`` (a change there recomputes its results);
     ``libraries``: distributions whose versions matter. ``has_footprint``:
-    whether it estimates a footprint (it is then listed in Table 3).
+    whether it estimates a footprint (it is then listed in Table 3). ``paper_name``:
+    its name in the BuildNet3D paper's Tables 2 and 3, whose published figures the
+    comparison shows beside its rows (``None``: the paper has no such method).
 
     Its config on a command line: ``options``, the flags that set its config's
     fields (:class:`~dataset.core.method_options.Option`; any field is also set with
@@ -110,6 +112,7 @@ class Method:
     options: tuple[Option, ...] = ()
     short_run: Mapping[str, Any] = field(default_factory=dict, hash=False)
     check_config: Callable[[Any, bool], None] | None = None
+    paper_name: str | None = None
 
     def config_record(self, config: Any) -> dict[str, Any]:
         """``config`` as this method's results record it."""

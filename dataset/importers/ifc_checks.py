@@ -15,7 +15,7 @@
 - the declared ``OverallWidth x OverallHeight`` of each IfcWindow is in the import's own
   record (``truth.extra["ifc"]["windows"]``).
 
-Used by ``bench/ifc_corpus.py`` and ``tests/test_ifc_real.py``.
+Used by ``bench/ifc_corpus.py`` and ``tests/dataset/importers/test_ifc_real.py``.
 """
 
 from __future__ import annotations

@@ -8,7 +8,10 @@ is the face's escape fraction: 0 for faces enclosed by the mesh (inner sides of 
 partitions, ceilings of a BIM export), and typically >= 0.3 for an outside wall. With a
 ground height, every ray that points downwards counts as stopped by the ground, so an
 open underside (no floor slab, a crawl space) does not let the inner sides of the walls
-see out; an outside wall then keeps about half its rays.
+see out; an outside wall then keeps about half its rays. With a ground box, the ground is
+the plane z = 0 within that x/y box only: a downward ray that leaves the box before it
+reaches z = 0 escapes, as a camera on the ground beyond the box would see along it
+(the wall under an eave, which the eave hides from every upward ray).
 """
 
 from __future__ import annotations
@@ -61,6 +64,7 @@ def escape_fractions(
     rays_per_sample: int,
     offset_m: float,
     ground: bool = False,
+    ground_box_xy_m: np.ndarray | None = None,
     show_progress: bool = True,
 ) -> np.ndarray:
     """Fraction of outward rays from each face that leave the mesh without a hit.
@@ -79,6 +83,10 @@ def escape_fractions(
         How far off the surface the rays start, above embree's float32 precision.
     ground
         Whether the faces stand above a ground: rays pointing downwards never escape.
+    ground_box_xy_m : (2, 2) float, optional
+        With ``ground``: ((x_min, y_min), (x_max, y_max)), world metres. The ground is then
+        the plane z = 0 within this box: a downward ray stops only where it meets z = 0
+        inside it (or starts below z = 0). None: every downward ray stops.
 
     Returns
     -------
@@ -109,7 +117,7 @@ def escape_fractions(
         d = d.reshape(-1, 3)
         hit = raycaster.occluded(o.reshape(-1, 3), d)
         if ground:
-            hit |= d[:, 2] < 0
+            hit |= _stopped_by_ground(o.reshape(-1, 3), d, ground_box_xy_m)
         escaped[lo:hi] = 1.0 - hit.reshape(hi - lo, -1).mean(axis=1)
     result[valid] = escaped
     return result
@@ -123,6 +131,7 @@ def seen_from_outside(
     offset_m: float,
     min_escape_fraction: float,
     ground: bool = True,
+    ground_box_xy_m: np.ndarray | None = None,
     show_progress: bool = False,
 ) -> np.ndarray:
     """(F,) bool over the raycaster's mesh: faces in ``which`` ((F,) bool) whose escape
@@ -133,9 +142,23 @@ def seen_from_outside(
         seen[which] = escape_fractions(
             raycaster, mesh.triangles_m[which], raycaster.face_normals[which],
             rays_per_sample=rays_per_sample, offset_m=offset_m, ground=ground,
-            show_progress=show_progress,
+            ground_box_xy_m=ground_box_xy_m, show_progress=show_progress,
         ) >= min_escape_fraction
     return seen
+
+
+def _stopped_by_ground(origins_m: np.ndarray, dirs: np.ndarray,
+                       box_xy_m: np.ndarray | None) -> np.ndarray:
+    """(N,) bool: rays (N, 3) pointing downwards that meet the ground: every one without a
+    box; with a (2, 2) x/y box, those that start below z = 0 or meet z = 0 inside it."""
+    down = dirs[:, 2] < 0
+    if box_xy_m is None:
+        return down
+    lo, hi = np.asarray(box_xy_m, dtype=np.float64)
+    t = np.divide(-origins_m[:, 2], dirs[:, 2], out=np.zeros(len(dirs)), where=down)
+    xy = origins_m[:, :2] + t[:, None] * dirs[:, :2]
+    inside = ((xy >= lo) & (xy <= hi)).all(axis=1)
+    return down & ((origins_m[:, 2] <= 0) | inside)
 
 
 def _to_world(local: np.ndarray, normals: np.ndarray) -> np.ndarray:

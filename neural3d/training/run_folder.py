@@ -31,7 +31,7 @@ from neural3d.field.normalisation import Normalisation
 TRAINING_CODE = ("dataset", "neural3d.config", "neural3d.field", "neural3d.rendering",
                  "neural3d.training", "neural3d.train")
 """The modules whose source a trained field depends on: extraction is not among them, so
-a change to meshing or measuring keeps a finished training (tests/test_neural3d_reuse.py
+a change to meshing or measuring keeps a finished training (tests/neural3d/test_neural3d_reuse.py
 checks that ``neural3d.train`` imports nothing of neural3d outside them)."""
 TRAINING_LIBRARIES = ("numpy", "torch")
 PriorRun = Literal["none", "partial", "finished"]

@@ -1,0 +1,36 @@
+"""Wiring of rays through the field: misses see only the environment; shapes."""
+
+import numpy as np
+import pytest
+import torch
+
+from neural3d.config import preset_config
+from neural3d.field.fields import SemanticSDF
+from neural3d.rendering.model import cos_anneal_ratio, render_rays
+
+
+@pytest.mark.slow
+def test_render_rays_hits_and_misses():
+    config = preset_config("tiny")
+    torch.manual_seed(0)
+    field = SemanticSDF(config.model, 4, np.full(3, -1.0), np.full(3, 1.0))  # sphere r = 0.5
+    lo, hi = torch.full((3,), -1.0), torch.full((3,), 1.0)
+    origins = torch.tensor([[0.0, 0.0, 3.0], [0.0, 3.0, 3.0]])
+    dirs = torch.tensor([[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]])  # through the sphere; past the box
+    out = render_rays(field, origins, dirs, lo, hi, config, step=0, training=True,
+                      background_class=0)
+    assert out.rgb.shape == (2, 3) and out.semantics.shape == (2, 4)
+    assert out.accumulation[0] > 0.9 and out.accumulation[1] == 0.0
+    assert torch.allclose(out.semantics[1], torch.tensor([1.0, 0.0, 0.0, 0.0]))
+    assert torch.allclose(out.rgb[1], field.background_rgb(dirs[1:]).detach()[0])
+    # The surface of the initial sphere (radius 0.5, +-0.1 wobble) is 2.5 from the origin.
+    assert abs(out.depth[0].item() - 2.5) < 0.15
+    n = config.samples_uniform + config.samples_importance - 1
+    assert out.sdf_gradients.shape == (n, 3)  # only the ray that enters the box is sampled
+    assert out.sdf_gradients.requires_grad
+
+
+def test_cos_anneal_ratio():
+    c = preset_config("paper")
+    assert cos_anneal_ratio(c, 0) == 0.0 and cos_anneal_ratio(c, c.cos_anneal_steps) == 1.0
+    assert cos_anneal_ratio(preset_config("fast"), 0) == 1.0
