@@ -13,6 +13,9 @@ a model; :func:`build_building` turns it into mesh + truth deterministically
 - ``lod3``: 49 real buildings, the Ingolstadt LoD3 CityGML models that have windows
   (family ``citygml``; files in ``dataset/examples/lod3_ingolstadt``, CC BY-SA 4.0,
   :mod:`dataset.importers.citygml_preset`).
+- ``segtrain``: 24 skyscrapers and 24 L-shaped buildings that are never evaluated, the
+  training set of the mask segmenter (``segment/``); no realistic building (its four
+  designs, only jittered, are the evaluated ones).
 
 Run ``python -m dataset.presets`` to print the ranges a preset spans.
 """
@@ -38,7 +41,7 @@ from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_param
 
 Family = Literal["skyscraper", "l_shaped", "realistic", "citygml"]
 FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "citygml")
-PRESETS = ("paper", "tiny", "heldout", "lod3")
+PRESETS = ("paper", "tiny", "heldout", "lod3", "segtrain")
 _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 # Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
@@ -59,6 +62,11 @@ _REALISTIC_SEED = 3000
 _HELDOUT_SEEDS = {"skyscraper": tuple(range(5000, 5006)), "l_shaped": tuple(range(6000, 6006))}
 _HELDOUT_DESIGN_SEED = 7000
 _LOD3_SEED = 4000  # + the building's index: cameras and looks of the lod3 scenes
+# Seeds of the segtrain preset: far from every evaluated preset's seeds (paper 1000-2199 and
+# 3000-3003, tiny, heldout 5000-7007, lod3 4000-4048), so the segmenter never sees a building
+# that is measured.
+_SEGTRAIN_FIRST_SEED = {"skyscraper": 1_000_000, "l_shaped": 2_000_000}
+_SEGTRAIN_PER_FAMILY = 24
 
 
 @dataclass(frozen=True)
@@ -133,6 +141,12 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
 
         return tuple(BuildingRecipe(e.id, "citygml", _LOD3_SEED + k, e.file)
                      for k, e in enumerate(lod3_entries()))
+    if name == "segtrain":
+        return tuple(
+            BuildingRecipe(f"segtrain_{family}_{i:02d}", family, first + i)
+            for family, first in _SEGTRAIN_FIRST_SEED.items()
+            for i in range(_SEGTRAIN_PER_FAMILY)
+        )
     raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
 
 

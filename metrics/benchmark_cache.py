@@ -30,12 +30,12 @@ class DefaultBenchmark:
         return self.root / self.preset
 
     def announce(self, methods: tuple[str, ...], steps: Mapping[str, int],
-                 comparisons: int = 1) -> str:
+                 comparisons: int = 1, inputs: str = "clean and degraded inputs") -> str:
         """The line printed before the default run starts: ``steps``, the training steps
         per building of the methods that train; ``comparisons`` > 1 for a study that
-        repeats the default comparison (with every method) that many times."""
+        repeats the default comparison (with every method) that many times, on ``inputs``."""
         made = "cached" if self.folder.is_dir() else "to be generated"
-        repeated = (f", {comparisons} comparisons (clean and degraded inputs)"
+        repeated = (f", {comparisons} comparisons ({inputs})"
                     if comparisons > 1 else "")
         return (
             f"Built-in default: the '{self.preset}' benchmark ({made} in {self.folder}, "

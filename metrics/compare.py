@@ -11,8 +11,9 @@ Markdown and LaTeX, per-building and per-facade CSVs, plots (PNG + PDF),
 then ``report.html``, all of it in one offline page (:mod:`metrics.html_report`).
 
 Its modes are small functions: :func:`compare_once` (with ``--degrade``, on
-degraded inputs), :func:`robustness_study` (``--robustness``) and
-:func:`explain_one` (``--explain``); ``main`` works out the folders once
+degraded inputs), :func:`compare_on_masks` (``--masks predicted[:MODEL]``, on a
+segmenter's masks beside the exact ones), :func:`robustness_study`
+(``--robustness``) and :func:`explain_one` (``--explain``); ``main`` works out the folders once
 (:func:`metrics.compare_args.compare_request`).
 """
 
@@ -55,6 +56,7 @@ from metrics.orientation_errors import (
     summarise_orientations,
 )
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.predicted_masks import compare_on_predicted_masks, masks_segmenter
 from metrics.report import (
     per_building_table,
     per_facade_table,
@@ -312,7 +314,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.robustness:
             return robustness_study(request, RobustnessStudy(
                 seed=args.degrade_seed, heavy_levels=args.robustness_heavy))
-        return compare_once(
+        mode = compare_on_masks if request.masks is not None else compare_once
+        return mode(
             request, f"python -m metrics.compare {argv_text}".strip(),
             allow_run=not args.no_run, reuse_stale=args.reuse_stale,
             execute=make_executor(args.executor, RayConfig(address=args.ray_address)))
@@ -340,6 +343,27 @@ def compare_once(request: CompareRequest, command: str, *, allow_run: bool, reus
         print(to_text(table))
     print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
           f"(results in {results}); {time.perf_counter() - start:.0f} s")
+    return 0
+
+
+def compare_on_masks(request: CompareRequest, command: str, *, allow_run: bool,
+                     reuse_stale: bool, execute: Execute) -> int:
+    """``--masks predicted[:MODEL]``: the comparison on the exact masks and on a segmenter's
+    (:mod:`metrics.predicted_masks`); print the table of both side by side. The segmenter is
+    loaded first: refused weights or plugins stop the run before anything is made."""
+    start = time.perf_counter()
+    assert request.masks is not None
+    segmenter = masks_segmenter(request.masks)
+    _prepare(request, comparisons=2, inputs="exact and predicted masks")
+    table, run = compare_on_predicted_masks(
+        segmenter, request.data, request.results, request.out,
+        lambda results: _specs(request, results), compare, command=command,
+        allow_run=allow_run, reuse_stale=reuse_stale, execute=execute)
+    print()
+    print(to_text(table))
+    print(f"wrote the exact-mask outputs to {request.out}, the predicted-mask outputs and "
+          f"{table.name} to {run.out} (masks in {run.data}, results in {run.results}); "
+          f"{time.perf_counter() - start:.0f} s")
     return 0
 
 
@@ -371,13 +395,15 @@ def _specs(request: CompareRequest, results: Path) -> list[MethodSpec]:
                         seeds=request.seeds)
 
 
-def _prepare(request: CompareRequest, comparisons: int = 1) -> None:
-    """For the built-in default run: say what it does, then generate its benchmark if absent."""
+def _prepare(request: CompareRequest, comparisons: int = 1,
+             inputs: str = "clean and degraded inputs") -> None:
+    """For the built-in default run: say what it does (``comparisons`` on ``inputs``), then
+    generate its benchmark if absent."""
     if request.default is None:
         return
     steps = {s.name: n for s in _specs(request, request.results)
              if (n := recorded_steps(s.config)) is not None}
-    print(request.default.announce(request.methods, steps, comparisons), flush=True)
+    print(request.default.announce(request.methods, steps, comparisons, inputs), flush=True)
     ensure_benchmark(request.default)
 
 

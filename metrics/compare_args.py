@@ -21,13 +21,15 @@ from dataset.executors.ray_tasks import add_executor_arguments
 from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
 from metrics.method_args import add_method_options, method_configs
 from metrics.methods import METHODS
+from metrics.predicted_masks import MasksRequest, parse_masks
 
 
 @dataclass(frozen=True)
 class CompareRequest:
     """What one call compares: ``data`` (resolved), ``results`` and ``out`` (their
     defaults worked out), the methods and views, each method's config, the built-in
-    default run (``default``, when ``--data`` is not given) and the ``--degrade`` specs."""
+    default run (``default``, when ``--data`` is not given), the ``--degrade`` specs and the
+    segmenter of ``--masks`` (``masks``; ``None``: the exact masks)."""
 
     data: Path
     results: Path
@@ -38,6 +40,7 @@ class CompareRequest:
     default: DefaultBenchmark | None
     degradation: tuple[DegradeSpec, ...]
     seeds: tuple[int, ...] = (0,)
+    masks: MasksRequest | None = None
 
 
 def parse_compare_args(argv: Sequence[str] | None,
@@ -82,6 +85,16 @@ def parse_compare_args(argv: Sequence[str] | None,
                         "<results>/degraded/, outputs to <out>-<key>")
     parser.add_argument("--degrade-seed", type=int, default=0,
                         help="seed of the degradations (default: 0)")
+    mode.add_argument(
+        "--masks", metavar="predicted[:MODEL]",
+        help="compare on a segmenter's masks instead of the exact ones (truth unchanged): "
+        "'predicted' uses the committed segmenter (segment/weights/default.pt), "
+        "'predicted:FILE.pt' other weights, 'predicted:NAME' an installed plugin "
+        "(entry point group envelope_bench.segmenters). The exact-mask comparison runs too; "
+        "masks are cached in <data>-masks/, results go to <results>/masks/, outputs to "
+        "<out>-masks-<key> with the table exact_vs_predicted. See docs/segment.md")
+    parser.add_argument("--masks-threads", type=int, default=2,
+                        help="--masks: torch threads of the segmenter (default: 2)")
     mode.add_argument("--robustness", action="store_true",
                         help="run the robustness study (mask noise, occluders, pose and depth "
                         "noise at three severities each; results in <results>/robustness, "
@@ -137,7 +150,7 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
     Raises
     ------
     ValueError
-        If a method option, ``--set`` or ``--degrade`` is refused.
+        If a method option, ``--set``, ``--degrade`` or ``--masks`` is refused.
     """
     default = DefaultBenchmark() if args.data is None else None
     data = (default.folder if default is not None else args.data).resolve()
@@ -150,7 +163,8 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
         out=args.out or data.with_name(f"{data.name}-compare"), methods=names,
         views=_listed(args.views), configs=configs, default=default,
         degradation=parse_specs(args.degrade, seed=args.degrade_seed) if args.degrade else (),
-        seeds=parse_seeds(args.seeds))
+        seeds=parse_seeds(args.seeds),
+        masks=parse_masks(args.masks, args.masks_threads) if args.masks else None)
 
 
 def _listed(text: str) -> tuple[str, ...]:

@@ -121,14 +121,17 @@ def find_scenes(data: str | Path) -> list[Path]:
     """Scene folders in ``data``: ``data`` itself if it is one, else its sub-folders that are.
 
     A scene folder holds ``transforms.json`` (images to run methods on) or
-    ``building.json`` (ground truth). Raises ``ValueError`` when there is none.
+    ``building.json`` (ground truth); hidden folders (``.<name>.partial``: a copy a killed
+    run left unfinished, see :func:`dataset.core.atomic.atomic_directory`) are not scenes.
+    Raises ``ValueError`` when there is none.
     """
     data = Path(data)
     if not data.is_dir():
         raise ValueError(f"data folder {data} does not exist")
     if _is_scene(data):
         return [data]
-    scenes = sorted(p for p in data.iterdir() if p.is_dir() and _is_scene(p))
+    scenes = sorted(p for p in data.iterdir()
+                    if p.is_dir() and not p.name.startswith(".") and _is_scene(p))
     if not scenes:
         raise ValueError(
             f"{data} holds no scene folder (one with transforms.json or building.json); "

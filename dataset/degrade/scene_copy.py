@@ -2,8 +2,9 @@
 
 Files that a degradation does not change (and the truth: ``building.json``,
 ``mesh.ply``, ``instances/``) are hard links to the original (copies across
-file systems); changed images are written as new files, so the original scene
-is never modified. ``transforms.json`` records the specs and the source under
+file systems, :func:`link_tree`, which the segmenter's mask copies share too);
+changed images are written as new files, so the original scene is never
+modified. ``transforms.json`` records the specs and the source under
 ``degradation``, which is how a rerun recognises a finished copy.
 """
 
@@ -81,7 +82,7 @@ def degrade_scene(source_dir: str | Path, out_root: str | Path,
         return out
     active = tuple(s for s in specs if s.severity > 0)
     with atomic_directory(out) as tmp:
-        _link_tree(Path(source_dir), tmp)
+        link_tree(Path(source_dir), tmp)
         occluders = _occluders_of(source, active)
         frames = [_degrade_frame(source, tmp, i, fr, active, occluders)
                   for i, fr in enumerate(source.frames)]
@@ -152,7 +153,7 @@ def _finished(out: Path, record: dict[str, Any]) -> bool:
         return False
 
 
-def _link_tree(src: Path, dst: Path) -> None:
+def link_tree(src: Path, dst: Path) -> None:
     """Hard-link every file of ``src`` into ``dst`` (copy where linking is impossible)."""
     for path in sorted(src.rglob("*")):
         target = dst / path.relative_to(src)

@@ -153,7 +153,7 @@ def test_checks_catch_broken_meshes(tiny_buildings):
 
 
 def test_bad_recipes_and_presets_raise_helpful_errors():
-    assert {"paper", "tiny", "heldout", "lod3"} <= set(PRESETS)
+    assert {"paper", "tiny", "heldout", "lod3", "segtrain"} <= set(PRESETS)
     with pytest.raises(ValueError, match="unknown preset"):
         preset_recipes("huge")
     with pytest.raises(ValueError, match="file-system safe"):

@@ -13,7 +13,7 @@ import pytest
 from paths import REPO_ROOT
 
 ROOT = REPO_ROOT
-PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
+PACKAGES = ("dataset", "baselines", "neural3d", "segment", "metrics", "figures")
 # Importers that issue 17 works on at the same time as this check was written; their frame
 # splits are converted to dataset.core.protocols' names when both branches meet.
 

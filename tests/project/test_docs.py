@@ -11,7 +11,7 @@ import pytest
 from paths import REPO_ROOT
 
 ROOT = REPO_ROOT
-PACKAGES = ("dataset", "baselines", "neural3d", "metrics", "figures")
+PACKAGES = ("dataset", "baselines", "neural3d", "segment", "metrics", "figures")
 FOLDERS = (*PACKAGES, "tests", "bench", "scripts", "docs")
 DOCS = sorted(p for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]
               if p.name != "decisions.md")

@@ -1,4 +1,4 @@
-"""Data flows one way: dataset -> baselines / neural3d -> metrics -> figures, never back.
+"""Data flows one way: dataset -> baselines / neural3d / segment -> metrics -> figures, never back.
 
 Read from the source files' import statements (``import x`` and ``from x import y``,
 at any depth, including the ones inside functions), not by importing anything.
@@ -12,7 +12,7 @@ from paths import REPO_ROOT
 
 ROOT = REPO_ROOT
 # A package may import the packages of a lower layer and its own, nothing later in the flow.
-LAYER = {"dataset": 0, "baselines": 1, "neural3d": 1, "metrics": 2, "figures": 3}
+LAYER = {"dataset": 0, "baselines": 1, "neural3d": 1, "segment": 1, "metrics": 2, "figures": 3}
 
 
 def project_imports(path: Path) -> set[str]:

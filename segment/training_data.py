@@ -1,0 +1,139 @@
+"""The segmenter's training frames: which scenes, the split by building, and batches.
+
+Only buildings that are never evaluated may be trained on: a scene whose generator
+record names an evaluated preset (every preset but ``segtrain``) is refused. The
+buildings are split by name (the same building rendered at two resolutions lands on
+the same side): every ``val_every``-th name in sorted order is a validation building,
+used to pick the best weights during training and never trained on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from dataset.core.classes import NUM_CLASSES
+from dataset.core.provenance import file_fingerprint
+from dataset.core.scene_record import Frame, Scene
+from dataset.presets import PRESETS, preset_recipes
+from dataset.scenes.images import read_rgb
+from dataset.scenes.scene import read_scene
+from dataset.scenes.scene_validation import read_frame_labels
+from segment.augment import IGNORE_LABEL, AugmentConfig, augment_frame
+from segment.scene_masks import scene_folders
+
+TRAINING_PRESET = "segtrain"
+EVALUATED_PRESETS: tuple[str, ...] = tuple(p for p in PRESETS if p != TRAINING_PRESET)
+
+
+@dataclass(frozen=True)
+class TrainingScene:
+    """One scene to train or validate on: its frames with masks, and its record."""
+
+    scene: Scene
+    frames: tuple[Frame, ...]
+    record: dict[str, Any]
+
+    @property
+    def name(self) -> str:
+        return self.scene.root.name
+
+    def rgb_and_labels(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+        """(H, W, 3) uint8 RGB and (H, W) uint8 exact class ids of one frame."""
+        return read_rgb(self.scene.path(frame.file_path)), read_frame_labels(self.scene, frame)
+
+
+def load_training_scenes(folders: Sequence[Path]) -> list[TrainingScene]:
+    """Every scene of ``folders`` (each a scene folder or a folder of them).
+
+    Raises
+    ------
+    ValueError
+        If a folder holds no scene, a scene has no masks, or a scene belongs to an
+        evaluated preset.
+    """
+    scenes = []
+    for folder in folders:
+        dirs = scene_folders(folder)
+        if not dirs:
+            raise ValueError(f"{folder} holds no scene folder; render the training buildings "
+                             f"with `python -m dataset.generate --preset {TRAINING_PRESET} "
+                             f"--out {folder}`")
+        scenes += [_training_scene(read_scene(d)) for d in dirs]
+    return scenes
+
+
+def split_by_building(scenes: Sequence[TrainingScene], val_every: int
+                      ) -> tuple[list[TrainingScene], list[TrainingScene]]:
+    """(train, validation): a building is for validation if its rank among the sorted
+    building names is ``val_every - 1`` modulo ``val_every`` (0: no validation)."""
+    names = sorted({s.name for s in scenes})
+    val_names = {n for i, n in enumerate(names) if val_every and i % val_every == val_every - 1}
+    return ([s for s in scenes if s.name not in val_names],
+            [s for s in scenes if s.name in val_names])
+
+
+def class_weights(scenes: Sequence[TrainingScene], rng: np.random.Generator,
+                  frames: int = 200) -> np.ndarray:
+    """(NUM_CLASSES,) loss weights ``sqrt(median frequency / frequency)`` measured on
+    ``frames`` random training masks (clipped to [0.1, 10]; 1 for an absent class)."""
+    pairs = [(s, f) for s in scenes for f in s.frames]
+    counts = np.zeros(NUM_CLASSES)
+    for i in rng.choice(len(pairs), size=min(frames, len(pairs)), replace=False):
+        scene, frame = pairs[i]
+        labels = read_frame_labels(scene.scene, frame)
+        counts += np.bincount(labels.ravel(), minlength=NUM_CLASSES)[:NUM_CLASSES]
+    present = counts > 0
+    freq = counts / counts.sum()
+    weights = np.ones(NUM_CLASSES)
+    weights[present] = np.sqrt(np.median(freq[present]) / freq[present])
+    return np.clip(weights, 0.1, 10.0)
+
+
+def sample_batch(scenes: Sequence[TrainingScene], batch: int, config: AugmentConfig,
+                 rng: np.random.Generator) -> tuple[torch.Tensor, torch.Tensor]:
+    """A batch of augmented crops from random frames of random scenes.
+
+    Returns ``Float[Tensor, "B 3 S S"]`` RGB in [0, 1] (channels-last memory) and
+    ``Long[Tensor, "B S S"]`` labels (:data:`IGNORE_LABEL` where there is none).
+    """
+    xs, ys = [], []
+    for _ in range(batch):
+        scene = scenes[rng.integers(len(scenes))]
+        rgb, labels = scene.rgb_and_labels(scene.frames[rng.integers(len(scene.frames))])
+        x, y = augment_frame(rgb, labels, config, rng)
+        xs.append(x)
+        ys.append(y)
+    x = torch.from_numpy(np.stack(xs)).permute(0, 3, 1, 2)
+    return x.contiguous(memory_format=torch.channels_last), torch.from_numpy(np.stack(ys))
+
+
+def _training_scene(scene: Scene) -> TrainingScene:
+    generator = scene.extra.get("generator") or {}
+    inputs = (generator.get("provenance") or {}).get("inputs") or {}
+    preset, recipe = inputs.get("preset"), inputs.get("recipe")
+    if preset in EVALUATED_PRESETS:
+        raise ValueError(f"{scene.root} is a building of the '{preset}' preset, which is "
+                         f"evaluated: the segmenter must never train on it; render the "
+                         f"training buildings with `python -m dataset.generate --preset "
+                         f"{TRAINING_PRESET}`")
+    frames = tuple(f for f in scene.frames if f.semantic_file_path is not None)
+    if not frames:
+        raise ValueError(f"{scene.root} has no semantic masks to train on")
+    seeds = {r.id: r.seed for r in preset_recipes(preset)} if preset in PRESETS else {}
+    record = {
+        "scene": scene.root.name, "folder": str(scene.root.parent), "preset": preset,
+        "recipe": recipe, "recipe_seed": seeds.get(recipe), "render_seed": inputs.get("seed"),
+        "resolution": scene.frames[0].intrinsics.width, "frames": len(frames),
+        "transforms": file_fingerprint(scene.path("transforms.json")),
+    }
+    return TrainingScene(scene, frames, record)
+
+
+__all__ = ["IGNORE_LABEL", "TrainingScene", "class_weights", "load_training_scenes",
+           "sample_batch", "split_by_building"]
