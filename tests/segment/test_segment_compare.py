@@ -110,6 +110,7 @@ def test_bad_masks_options_are_refused_before_anything_runs(one_scene, tmp_path,
     assert not (tmp_path / "data-masks").exists() and not (tmp_path / "r").exists()
 
 
+@pytest.mark.slow
 def test_a_plugin_with_wrong_answers_stops_the_run_and_leaves_no_masks(one_scene, tmp_path,
                                                                        monkeypatch, capsys):
     source = "import numpy as np\ndef segment(rgb):\n    return np.zeros((3, 3), np.uint8)\n"

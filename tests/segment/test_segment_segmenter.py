@@ -64,6 +64,7 @@ def test_the_documented_example_is_20_lines_or_so():
     assert len(doc_blocks("python")[0].strip().splitlines()) <= 20
 
 
+@pytest.mark.slow
 def test_a_plugin_segmenter_is_found_checked_and_compared(tiny_benchmark, tmp_path, monkeypatch):
     name = install_toy_plugin(tmp_path / "site", monkeypatch)
     try:

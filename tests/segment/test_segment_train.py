@@ -40,6 +40,7 @@ def trained(clean_scene, tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_a_few_steps_write_weights_with_their_record(trained, clean_scene):
     record = json.loads(trained.with_suffix(".json").read_text())
     assert record["steps_run"] == 3 and not record["cut_short"]
