@@ -19,6 +19,7 @@ import numpy as np
 import torch
 from torch import Tensor, nn
 from torch.autograd.function import once_differentiable
+from torch.profiler import record_function
 
 _PRIMES = (1, 2654435761, 805459861)  # instant-ngp's spatial hash
 
@@ -163,7 +164,8 @@ class GridEncoding(nn.Module):
             h = a[:, :, 0, :, None, None] ^ a[:, :, 1, None, :, None] ^ a[:, :, 2, None, None, :]
             parts.append(h % self.sizes[nd:, None, None, None])
         index = torch.cat(parts, 1) + self.offsets[:, None, None, None]  # (N, L, 2, 2, 2)
-        values = _FlatGather.apply(self.table, index.reshape(n, self.levels, 8))  # (N, L, 8, F)
+        with record_function("neural3d.encoding gather"):
+            values = _FlatGather.apply(self.table, index.reshape(n, self.levels, 8))  # (N,L,8,F)
         feats = torch.stack([(weights * values[..., f]).sum(-1)
                              for f in range(self.features)], -1)  # (N, L, F)
         return (feats * self.level_mask[:, None]).reshape(n, self.out_dim)
@@ -181,7 +183,8 @@ class PositionalInput(nn.Module):
         """No schedule: the encoding is fixed."""
 
     def forward(self, x: Tensor) -> Tensor:
-        return positional_encoding(x, self.frequencies)
+        with record_function("neural3d.encoding"):
+            return positional_encoding(x, self.frequencies)
 
 
 class GridInput(nn.Module):
@@ -204,5 +207,6 @@ class GridInput(nn.Module):
         self.grid.set_active_levels(self.start_levels + ramp * (levels - self.start_levels))
 
     def forward(self, x: Tensor) -> Tensor:
-        return torch.cat([x, self.grid(x)], dim=-1)
+        with record_function("neural3d.encoding"):
+            return torch.cat([x, self.grid(x)], dim=-1)
 
