@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass, fields, replace
 from typing import Any, Literal
 
 Backbone = Literal["mlp", "grid"]
-Normals = Literal["analytic", "finite_difference"]
+Normals = Literal["analytic", "autograd", "finite_difference"]
 PresetName = Literal["paper", "fast", "tiny"]
 PRESETS: tuple[str, ...] = ("paper", "fast", "tiny")
 
@@ -63,6 +63,9 @@ class TrainConfig:
     samples_uniform: int = 24
     samples_importance: int = 24
     upsample_steps: int = 2
+    # samples whose rendering weight is at most this are dropped from the rendering (their
+    # colour and semantics are not evaluated); 0 = keep every sample
+    min_sample_weight: float = 0.0
     cos_anneal_steps: int = 0  # NeuS cos-anneal length; 0 = no annealing
     rgb_weight: float = 1.0
     eikonal_weight: float = 0.1
@@ -110,10 +113,9 @@ class TrainConfig:
             )
         if self.model.backbone not in ("mlp", "grid"):
             raise ValueError(f"unknown backbone {self.model.backbone!r}; use 'mlp' or 'grid'")
-        if self.model.normals not in ("analytic", "finite_difference"):
-            raise ValueError(
-                f"unknown normals {self.model.normals!r}; use 'analytic' or 'finite_difference'"
-            )
+        if self.model.normals not in ("analytic", "autograd", "finite_difference"):
+            raise ValueError(f"unknown normals {self.model.normals!r}; use 'analytic', "
+                             "'autograd' or 'finite_difference'")
 
 
 def preset_config(name: PresetName) -> TrainConfig:

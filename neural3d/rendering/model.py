@@ -73,13 +73,21 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
         pts = (o[:, None, :] + d[:, None, :] * t_mid[..., None]).reshape(-1, 3)
         dirs_s = d[:, None, :].expand(n_rays, n_samples, 3).reshape(-1, 3)
     sdf, feature, grad = field.sdf_feature_gradient(pts, create_graph=training)
-    rgb = field.colour(pts, dirs_s, grad, feature).reshape(n_rays, n_samples, 3)
-    logits = field.semantic_logits(feature).reshape(n_rays, n_samples, field.num_classes)
     with record_function("neural3d.compositing"):
         cos = (grad * dirs_s).sum(-1).reshape(n_rays, n_samples)
         alpha = neus_alpha(sdf.reshape(n_rays, n_samples), cos, lengths, field.inv_s(),
                            cos_anneal_ratio=cos_anneal_ratio(config, step))
         weights = weights_from_alpha(alpha)
+        kept = None
+        if config.min_sample_weight > 0:  # light samples are dropped (as if transparent)
+            heavy = weights.detach() > config.min_sample_weight
+            weights = weights * heavy
+            kept = torch.nonzero(heavy.reshape(-1)).squeeze(1)
+    rgb = _at_samples(field.colour, kept, pts, dirs_s, grad, feature)
+    logits = _at_samples(field.semantic_logits, kept, feature)
+    with record_function("neural3d.compositing"):
+        rgb = rgb.reshape(n_rays, n_samples, 3)
+        logits = logits.reshape(n_rays, n_samples, field.num_classes)
         background = field.background_rgb(dirs)
         num_classes = field.num_classes
         sem_full = torch.zeros(len(origins), num_classes, dtype=dirs.dtype, device=dirs.device)
@@ -93,3 +101,12 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
             accumulation=zeros.index_copy(0, idx, render_accumulation(weights)),
             sdf_gradients=grad,
         )
+
+
+def _at_samples(head, kept: Tensor | None, *inputs: Tensor) -> Tensor:
+    """``head(*inputs)`` "(M, D)" at every sample, evaluated only at the ``kept`` rows (zeros
+    elsewhere, where the weight is 0); every row when ``kept`` is None."""
+    if kept is None:
+        return head(*inputs)
+    out = head(*(x[kept] for x in inputs))
+    return out.new_zeros(len(inputs[0]), out.shape[1]).index_copy(0, kept, out)
