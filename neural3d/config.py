@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass, fields, replace
 from typing import Any, Literal
 
 Backbone = Literal["mlp", "grid"]
-Normals = Literal["analytic", "autograd", "finite_difference"]
+Normals = Literal["analytic", "finite_difference"]
 PresetName = Literal["paper", "fast", "tiny"]
 PRESETS: tuple[str, ...] = ("paper", "fast", "tiny")
 
@@ -113,9 +113,10 @@ class TrainConfig:
             )
         if self.model.backbone not in ("mlp", "grid"):
             raise ValueError(f"unknown backbone {self.model.backbone!r}; use 'mlp' or 'grid'")
-        if self.model.normals not in ("analytic", "autograd", "finite_difference"):
-            raise ValueError(f"unknown normals {self.model.normals!r}; use 'analytic', "
-                             "'autograd' or 'finite_difference'")
+        if self.model.normals not in ("analytic", "finite_difference"):
+            raise ValueError(
+                f"unknown normals {self.model.normals!r}; use 'analytic' or 'finite_difference'"
+            )
 
 
 def preset_config(name: PresetName) -> TrainConfig:

@@ -81,35 +81,6 @@ class _FlatGather(torch.autograd.Function):
         return scatter_add_rows(grad, index, ctx.rows), None
 
 
-class _Interpolate(torch.autograd.Function):
-    """Gather each point's corner rows and mix them: "(N, L, K, 8)" mixing rows @ "(N, L, 8, F)".
-
-    ``table[index]`` (:func:`gather_rows`) for an "(N, L, 8)" index, mixed by K rows
-    of corner coefficients per point and level (the trilinear weights, and for the
-    Jacobian their derivatives along each axis) -> "(N, L, K, F)". The backward
-    scatters every row's share with one :func:`scatter_add_rows`, so the Jacobian
-    costs no second backward pass through the table.
-    """
-
-    @staticmethod
-    def forward(ctx, table: Tensor, index: Tensor, rows: Tensor) -> Tensor:  # noqa: D102
-        values = gather_rows(table, index)  # (N, L, 8, F)
-        ctx.save_for_backward(index, rows, values if ctx.needs_input_grad[2] else None)
-        ctx.n_rows = table.shape[0]
-        return rows @ values
-
-    @staticmethod
-    @once_differentiable
-    def backward(ctx, grad: Tensor) -> tuple[Tensor | None, None, Tensor | None]:  # noqa: D102
-        index, rows, values = ctx.saved_tensors
-        grad_table = grad_rows = None
-        if ctx.needs_input_grad[0]:
-            grad_table = scatter_add_rows(rows.transpose(-1, -2) @ grad, index, ctx.n_rows)
-        if ctx.needs_input_grad[2]:
-            grad_rows = grad @ values.transpose(-1, -2)
-        return grad_table, None, grad_rows
-
-
 class GridEncoding(nn.Module):
     """Multi-resolution grid over an axis-aligned box of the normalised frame.
 
@@ -159,7 +130,6 @@ class GridEncoding(nn.Module):
         strides = [[1, r[0] + 1, (r[0] + 1) * (r[1] + 1)] for r in res]
         self.register_buffer("strides", torch.tensor(strides), persistent=False)  # (L, 3)
         self.register_buffer("primes", torch.tensor(_PRIMES), persistent=False)
-        self.table_size = table
         self.register_buffer("two", torch.arange(2), persistent=False)
         self.register_buffer("level_mask", torch.ones(levels), persistent=False)
         self.table = nn.Parameter(torch.empty(total, features).uniform_(-1e-4, 1e-4))
@@ -170,48 +140,18 @@ class GridEncoding(nn.Module):
         self.level_mask.copy_(ramp)
 
     def forward(self, x: Tensor) -> Tensor:
-        index, frac = self._cells(x)
-        weights = _trilinear_weights(frac)
-        with record_function("neural3d.encoding gather"):
-            values = _FlatGather.apply(self.table, index)  # (N, L, 8, F)
-        feats = torch.stack([(weights * values[..., f]).sum(-1)
-                             for f in range(self.features)], -1)  # (N, L, F)
-        return (feats * self.level_mask[:, None]).reshape(len(x), self.out_dim)
-
-    def with_jacobian(self, x: Tensor) -> tuple[Tensor, Tensor]:
-        """Features "(N, out_dim)" and their Jacobian "(N, 3, out_dim)" (d feature / d x).
-
-        The Jacobian is exact (the derivative of the trilinear interpolation, 0 along
-        an axis where the point is clamped to the box) and differentiable in the
-        table; neither output is differentiable in ``x``.
-        """
-        x = x.detach()
-        index, frac = self._cells(x)
-        weights = _trilinear_weights(frac)  # (N, L, 8)
-        rows = torch.cat([weights[:, :, None], _trilinear_slopes(frac)], 2)  # (N, L, 4, 8)
-        with record_function("neural3d.encoding gather"):
-            mixed = _Interpolate.apply(self.table, index, rows)  # (N, L, 4, F)
-        mixed = mixed * self.level_mask[:, None, None]
-        n = len(x)
-        features = mixed[:, :, 0].reshape(n, self.out_dim)
-        u = (x - self.box_min) / self.box_size
-        inside = ((u >= 0) & (u <= 1)).to(x.dtype)  # (N, 3): the clamp's derivative
-        per_unit = self.res / self.box_size  # (L, 3) cells per unit length
-        jacobian = mixed[:, :, 1:] * per_unit[:, :, None]  # (N, L, 3, F)
-        jacobian = jacobian.transpose(1, 2).reshape(n, 3, self.out_dim) * inside[:, :, None]
-        return features, jacobian
-
-    def _cells(self, x: Tensor) -> tuple[Tensor, Tensor]:
-        """Table rows "(N, L, 8)" of each point's cell corners and its position in the cell
-        "(N, L, 3)" in [0, 1] (differentiable in ``x``); points are clamped to the box."""
         if x.ndim != 2 or x.shape[1] != 3:
             raise ValueError(f"GridEncoding expects (N, 3) points, got {tuple(x.shape)}")
         n = len(x)
         u = ((x - self.box_min) / self.box_size).clamp(0, 1)  # (N, 3) in the unit cube
         pos = u[:, None, :] * self.res  # (N, L, 3)
         i0 = pos.detach().floor().long().clamp(max=self.res - 1)
-        frac = pos - i0  # (N, L, 3)
+        frac = pos - i0  # (N, L, 3), differentiable in x
         # Corner c = 4 bx + 2 by + bz of each cell, for weights and indices alike.
+        fx, fy, fz = frac.unbind(-1)  # (N, L) each
+        gx, gy, gz = 1 - fx, 1 - fy, 1 - fz
+        xy = (gx * gy, gx * fy, fx * gy, fx * fy)
+        weights = torch.stack([a * b for a in xy for b in (gz, fz)], -1)  # (N, L, 8)
         ic = i0[..., None] + self.two  # (N, L, 3, 2)
         nd = self.n_dense
         parts = []
@@ -222,30 +162,13 @@ class GridEncoding(nn.Module):
         if nd < self.levels:
             a = ic[:, nd:] * self.primes[:, None]
             h = a[:, :, 0, :, None, None] ^ a[:, :, 1, None, :, None] ^ a[:, :, 2, None, None, :]
-            parts.append(h & (self.table_size - 1))  # hashed levels fill the whole table
+            parts.append(h % self.sizes[nd:, None, None, None])
         index = torch.cat(parts, 1) + self.offsets[:, None, None, None]  # (N, L, 2, 2, 2)
-        return index.reshape(n, self.levels, 8), frac
-
-
-def _trilinear_weights(frac: Tensor) -> Tensor:
-    """"(N, L, 3)" position in the cell -> "(N, L, 8)" weight of corner c = 4 bx + 2 by + bz."""
-    fx, fy, fz = frac.unbind(-1)
-    gx, gy, gz = 1 - fx, 1 - fy, 1 - fz
-    xy = (gx * gy, gx * fy, fx * gy, fx * fy)
-    return torch.stack([a * b for a in xy for b in (gz, fz)], -1)
-
-
-def _trilinear_slopes(frac: Tensor) -> Tensor:
-    """"(N, L, 3)" -> "(N, L, 3, 8)": d weight of corner c / d frac along each axis."""
-    fx, fy, fz = frac.unbind(-1)
-    gx, gy, gz = 1 - fx, 1 - fy, 1 - fz
-    yz = (gy * gz, gy * fz, fy * gz, fy * fz)  # corner order (by, bz)
-    xz = (gx * gz, gx * fz, fx * gz, fx * fz)  # (bx, bz)
-    xy = (gx * gy, gx * fy, fx * gy, fx * fy)  # (bx, by)
-    d_x = torch.stack([-v for v in yz] + list(yz), -1)  # bx = 0: -, bx = 1: +
-    d_y = torch.stack([-xz[0], -xz[1], xz[0], xz[1], -xz[2], -xz[3], xz[2], xz[3]], -1)
-    d_z = torch.stack([s * v for v in xy for s in (-1, 1)], -1)
-    return torch.stack([d_x, d_y, d_z], 2)
+        with record_function("neural3d.encoding gather"):
+            values = _FlatGather.apply(self.table, index.reshape(n, self.levels, 8))  # (N,L,8,F)
+        feats = torch.stack([(weights * values[..., f]).sum(-1)
+                             for f in range(self.features)], -1)  # (N, L, F)
+        return (feats * self.level_mask[:, None]).reshape(n, self.out_dim)
 
 
 class PositionalInput(nn.Module):
@@ -262,22 +185,6 @@ class PositionalInput(nn.Module):
     def forward(self, x: Tensor) -> Tensor:
         with record_function("neural3d.encoding"):
             return positional_encoding(x, self.frequencies)
-
-    def with_jacobian(self, x: Tensor) -> tuple[Tensor, Tensor]:
-        """The encoding "(N, out_dim)" and its Jacobian "(N, 3, out_dim)" (d encoding / d x)."""
-        with record_function("neural3d.encoding"):
-            n, f = len(x), self.frequencies
-            eye = torch.eye(3, dtype=x.dtype, device=x.device)
-            if f == 0:
-                return x, eye.expand(n, 3, 3)
-            scales = 2.0 ** torch.arange(f, dtype=x.dtype, device=x.device)
-            xs = x[:, None, :] * scales[:, None]  # (N, F, 3)
-            sin, cos = torch.sin(xs), torch.cos(xs)
-            per_axis = eye[None, :, None, :]  # d x_j / d x_d as "(1, 3, 1, 3)"
-            d_sin = ((cos * scales[:, None])[:, None] * per_axis).reshape(n, 3, 3 * f)
-            d_cos = ((-sin * scales[:, None])[:, None] * per_axis).reshape(n, 3, 3 * f)
-            encoding = torch.cat([x, sin.reshape(n, -1), cos.reshape(n, -1)], -1)
-            return encoding, torch.cat([eye.expand(n, 3, 3), d_sin, d_cos], -1)
 
 
 class GridInput(nn.Module):
@@ -302,11 +209,4 @@ class GridInput(nn.Module):
     def forward(self, x: Tensor) -> Tensor:
         with record_function("neural3d.encoding"):
             return torch.cat([x, self.grid(x)], dim=-1)
-
-    def with_jacobian(self, x: Tensor) -> tuple[Tensor, Tensor]:
-        """The input "(N, out_dim)" and its Jacobian "(N, 3, out_dim)" (d input / d x)."""
-        with record_function("neural3d.encoding"):
-            features, jacobian = self.grid.with_jacobian(x)
-            eye = torch.eye(3, dtype=x.dtype, device=x.device).expand(len(x), 3, 3)
-            return torch.cat([x, features], -1), torch.cat([eye, jacobian], -1)
 

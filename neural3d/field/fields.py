@@ -17,7 +17,6 @@ import math
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 from torch import Tensor, nn
 from torch.nn.utils.parametrizations import weight_norm
 from torch.profiler import record_function
@@ -63,27 +62,6 @@ class GeometricMLP(nn.Module):
             if i < len(self.linears) - 1:
                 h = self.act(h)
         return h
-
-    def with_gradient(self, inputs: Tensor, input_jacobian: Tensor) -> tuple[Tensor, Tensor]:
-        """Outputs "(N, out_dim)" and the gradient "(N, 3)" of the first one (the SDF).
-
-        ``input_jacobian`` "(N, 3, d_in)": d inputs / d x. Forward-mode
-        differentiation, one tangent per axis carried through every layer: first-order
-        operations only, so the eikonal term needs no double backward pass.
-        """
-        h, t = inputs, input_jacobian
-        last = len(self.linears) - 1
-        for i, lin in enumerate(self.linears):
-            if i == self.skip:
-                h = torch.cat([h, inputs], dim=-1) / math.sqrt(2)
-                t = torch.cat([t, input_jacobian], dim=-1) / math.sqrt(2)
-            weight = lin.weight  # weight normalisation applies here
-            if i == last:
-                return F.linear(h, weight, lin.bias), t @ weight[0]
-            h = F.linear(h, weight, lin.bias)
-            t = (t @ weight.T) * torch.sigmoid(_SOFTPLUS_BETA * h)[:, None, :]
-            h = self.act(h)
-        raise AssertionError("unreachable: the last layer returns")
 
 
 def _geometric_init(lin: nn.Linear, i: int, n: int, d_in: int, radius: float,
@@ -167,14 +145,6 @@ class SDFNetwork(nn.Module):
             h = self.mlp(features)
         return h[:, 0], h[:, 1:]
 
-    def with_gradient(self, x: Tensor) -> tuple[Tensor, Tensor, Tensor]:
-        """SDF "(N,)", feature "(N, F)" and the SDF's exact gradient "(N, 3)" at "(N, 3)",
-        in first-order operations (differentiable in the weights, not in ``x``)."""
-        features, jacobian = self.encoding.with_jacobian(x)
-        with record_function("neural3d.sdf mlp"):
-            h, grad = self.mlp.with_gradient(features, jacobian)
-        return h[:, 0], h[:, 1:], grad
-
 
 class ColourNetwork(nn.Module):
     """(x "(N, 3)", view dir "(N, 3)", normal "(N, 3)", feature "(N, F)") -> RGB "(N, 3)"."""
@@ -237,9 +207,6 @@ class SemanticSDF(nn.Module):
             with record_function("neural3d.sdf gradient"):
                 s = self.sdf_net(xs)[0].reshape(len(x), 2, 3)
             return sdf, feature, (s[:, 0] - s[:, 1]) / (2 * h)
-        if self.config.normals == "analytic":
-            with torch.set_grad_enabled(create_graph and torch.is_grad_enabled()):
-                return self.sdf_net.with_gradient(x)
         with torch.enable_grad():
             x = x.detach().requires_grad_(True) if not x.requires_grad else x
             sdf, feature = self.sdf_net(x)
