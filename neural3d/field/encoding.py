@@ -38,7 +38,7 @@ _ROW_DTYPES = {(torch.float32, 1): torch.float32, (torch.float32, 2): torch.floa
 
 
 def gather_rows(table: Tensor, index: Tensor) -> Tensor:
-    """``table[index]`` for a "(T, F)" table and an int64 index of any shape -> "(*index, F)".
+    """``table[index]`` for a "(T, F)" table and an int32 or int64 index of any shape -> "(*index, F)".
 
     A float32 row of 1, 2 or 4 features is read as one 4-, 8- or 16-byte element,
     so ``index_select`` copies one element per row (no autograd).
@@ -102,7 +102,7 @@ class GridEncoding(nn.Module):
         extent = hi - lo
         growth = math.exp((math.log(max_res) - math.log(min_res)) / max(levels - 1, 1))
         table = 2**log2_table
-        res, offsets, hashed, sizes = [], [], [], []
+        res, offsets, hashed = [], [], []
         total = 0
         for level in range(levels):
             r = min_res * growth**level
@@ -112,25 +112,32 @@ class GridEncoding(nn.Module):
             res.append(r_axes)
             offsets.append(total)
             hashed.append(n_vertices > table)
-            sizes.append(size)
             total += size
         self.levels, self.features = levels, features
         self.out_dim = levels * features
+        if total >= 2**31:
+            raise ValueError(f"grid table of {total} rows does not fit int32 indices; lower "
+                             "log2_table or levels")
         # Buffers derived from the config are not saved: a checkpoint holds learnt weights.
+        # Indices are int32 (about 2x faster to compute than int64 on CPU); only the hashed
+        # levels' products with the primes need int64.
+        i32 = torch.int32
         self.register_buffer("box_min", torch.tensor(lo, dtype=torch.float32), persistent=False)
         self.register_buffer("box_size", torch.tensor(extent, dtype=torch.float32),
                              persistent=False)
-        self.register_buffer("res", torch.tensor(np.stack(res)), persistent=False)  # (L, 3) int64
-        self.register_buffer("offsets", torch.tensor(offsets), persistent=False)  # (L,)
+        self.register_buffer("res", torch.tensor(np.stack(res), dtype=i32),
+                             persistent=False)  # (L, 3)
+        self.register_buffer("offsets", torch.tensor(offsets, dtype=i32), persistent=False)
         self.register_buffer("hashed", torch.tensor(hashed), persistent=False)  # (L,) bool
-        self.register_buffer("sizes", torch.tensor(sizes), persistent=False)  # (L,)
+        self.hash_mask = table - 1  # hashed levels fill the table, a power of two
         self.n_dense = int(sum(not h for h in hashed))
         if any(hashed[: self.n_dense]):
             raise AssertionError("dense levels must come first")  # resolution grows per level
         strides = [[1, r[0] + 1, (r[0] + 1) * (r[1] + 1)] for r in res]
-        self.register_buffer("strides", torch.tensor(strides), persistent=False)  # (L, 3)
-        self.register_buffer("primes", torch.tensor(_PRIMES), persistent=False)
-        self.register_buffer("two", torch.arange(2), persistent=False)
+        self.register_buffer("strides", torch.tensor(strides, dtype=i32),
+                             persistent=False)  # (L, 3)
+        self.register_buffer("primes", torch.tensor(_PRIMES), persistent=False)  # int64
+        self.register_buffer("two", torch.arange(2, dtype=i32), persistent=False)
         self.register_buffer("level_mask", torch.ones(levels), persistent=False)
         self.table = nn.Parameter(torch.empty(total, features).uniform_(-1e-4, 1e-4))
 
@@ -145,7 +152,7 @@ class GridEncoding(nn.Module):
         n = len(x)
         u = ((x - self.box_min) / self.box_size).clamp(0, 1)  # (N, 3) in the unit cube
         pos = u[:, None, :] * self.res  # (N, L, 3)
-        i0 = pos.detach().floor().long().clamp(max=self.res - 1)
+        i0 = pos.detach().floor().int().clamp(max=self.res - 1)
         frac = pos - i0  # (N, L, 3), differentiable in x
         # Corner c = 4 bx + 2 by + bz of each cell, for weights and indices alike.
         fx, fy, fz = frac.unbind(-1)  # (N, L) each
@@ -160,9 +167,9 @@ class GridEncoding(nn.Module):
             parts.append(a[:, :, 0, :, None, None] + a[:, :, 1, None, :, None]
                          + a[:, :, 2, None, None, :])
         if nd < self.levels:
-            a = ic[:, nd:] * self.primes[:, None]
+            a = ic[:, nd:].long() * self.primes[:, None]
             h = a[:, :, 0, :, None, None] ^ a[:, :, 1, None, :, None] ^ a[:, :, 2, None, None, :]
-            parts.append(h % self.sizes[nd:, None, None, None])
+            parts.append((h & self.hash_mask).int())
         index = torch.cat(parts, 1) + self.offsets[:, None, None, None]  # (N, L, 2, 2, 2)
         with record_function("neural3d.encoding gather"):
             values = _FlatGather.apply(self.table, index.reshape(n, self.levels, 8))  # (N,L,8,F)

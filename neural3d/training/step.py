@@ -58,8 +58,7 @@ class StepResult:
 @torch.no_grad()
 def update_ema(average: torch.nn.Module, field: torch.nn.Module, decay: float) -> None:
     """``average`` <- decay * average + (1 - decay) * field (parameters); buffers copied."""
-    for a, p in zip(average.parameters(), field.parameters()):
-        a.lerp_(p, 1.0 - decay)
+    torch._foreach_lerp_(list(average.parameters()), list(field.parameters()), 1.0 - decay)
     for a, b in zip(average.buffers(), field.buffers()):
         a.copy_(b)
 
