@@ -91,6 +91,15 @@ def test_coarse_to_fine_masks_levels():
     assert torch.allclose(out, torch.tensor([1.0, 1.0, 0.5, 0.5, 0.0, 0.0]))
 
 
+def test_indices_are_int32_and_a_table_beyond_them_is_refused():
+    enc = grid(levels=3, min_res=4, max_res=64, log2_table=12)  # dense, dense, hashed
+    index, _ = enc._cells(torch.rand(50, 3) * 2 - 1)
+    assert index.dtype == torch.int32
+    assert 0 <= int(index.min()) and int(index.max()) < len(enc.table)
+    with pytest.raises(ValueError, match="int32"):
+        grid(levels=2, min_res=2048, max_res=2048, log2_table=30)  # 2 x 2^30 rows
+
+
 def test_bad_inputs():
     with pytest.raises(ValueError, match=r"\(N, 3\)"):
         grid()(torch.zeros(4, 2))
