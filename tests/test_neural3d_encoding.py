@@ -82,6 +82,15 @@ def test_row_gather_and_its_scatter_match_indexing(features):
     assert got.dtype == table.dtype and torch.allclose(got, expected, atol=1e-5)
 
 
+def test_no_points_give_a_zero_gradient():
+    """A batch whose rays all miss the occupied cells evaluates the grid at no point."""
+    enc = grid()
+    out = enc(torch.zeros(0, 3))
+    assert out.shape == (0, enc.out_dim)
+    (g,) = torch.autograd.grad(out.sum(), enc.table, allow_unused=False)
+    assert g.shape == enc.table.shape and not g.any()
+
+
 def test_coarse_to_fine_masks_levels():
     enc = grid()
     with torch.no_grad():

@@ -61,7 +61,7 @@ def scatter_add_rows(grad: Tensor, index: Tensor, rows: int) -> Tensor:
     on CPU is about 3x faster than ``index_add_`` on the rows.
     """
     flat = index.reshape(-1)
-    per_feature = grad.reshape(len(flat), -1).unbind(1)
+    per_feature = grad.reshape(len(flat), grad.shape[-1]).unbind(1)  # no -1: N may be 0
     sums = [torch.bincount(flat, weights=g, minlength=rows) for g in per_feature]
     return torch.stack(sums, 1).to(grad.dtype)
 
