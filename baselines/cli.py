@@ -16,11 +16,11 @@ from pathlib import Path
 from tqdm import tqdm
 
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
+from dataset.core.method_input import MethodInput
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.core.results import MethodResult, write_result
-from dataset.core.scene_record import Scene
 from dataset.core.warnings_summary import summarise_warnings
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input
 
 
 def scene_folders(data: Path) -> list[Path]:
@@ -68,7 +68,7 @@ def add_common_arguments(parser: argparse.ArgumentParser) -> None:
     add_debug_flag(parser)
 
 
-def run_scenes(data: Path, out: Path | None, run_one: Callable[[Scene], MethodResult]) -> int:
+def run_scenes(data: Path, out: Path | None, run_one: Callable[[MethodInput], MethodResult]) -> int:
     """Run one method on every scene of ``data``; write and print result files; exit code.
 
     Warnings and per-scene failures go to stderr; a scene that fails does not
@@ -84,7 +84,7 @@ def run_scenes(data: Path, out: Path | None, run_one: Callable[[Scene], MethodRe
     written, failures = 0, []
     for folder in tqdm(folders, desc="scenes", unit="scene", disable=len(folders) < 2):
         try:
-            result = run_one(read_scene(folder))
+            result = run_one(read_method_input(folder))
         except ValueError as exc:
             failures.append(one_line(exc))
             if len(folders) > 1:

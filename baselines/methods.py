@@ -7,13 +7,14 @@ from pathlib import Path
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
 from dataset.core.method import Method
+from dataset.core.method_input import MethodInput
 from dataset.core.protocols import VIEW_PROTOCOLS
-from dataset.core.scene_record import Scene
 
 LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")
 
 
-def debug_images_2dss(scene: Scene, protocol: str, config: Wwr2dssConfig, folder: Path) -> None:
+def debug_images_2dss(scene: MethodInput, protocol: str, config: Wwr2dssConfig,
+                      folder: Path) -> None:
     """Run 2D-SS on ``scene`` only to write its pipeline images into ``folder``."""
     run_2dss(scene, protocol, config, debug_dir=folder)
 

@@ -14,8 +14,9 @@ from typing import Literal
 import numpy as np
 
 from dataset.core.camera import Intrinsics
+from dataset.core.method_input import MethodInput, require_method_input
 from dataset.core.protocols import VIEW_PROTOCOLS, ViewProtocol
-from dataset.core.scene_record import Frame, Scene, scene_name
+from dataset.core.scene_record import Frame, scene_name
 from dataset.scenes.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
 
 Protocol = ViewProtocol  # the 2D methods' protocols (dataset.core.protocols)
@@ -73,7 +74,7 @@ class LoadedViews:
             self.skipped.setdefault(facade_id, []).append(reason)
 
 
-def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "optional",
+def load_views(scene: MethodInput, protocol: Protocol, *, depth: Literal["required", "optional",
                "no"]) -> LoadedViews:
     """Read the semantic (and depth) images of every frame of ``protocol``.
 
@@ -88,7 +89,10 @@ def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "
     ------
     ValueError
         If ``protocol`` is not "ideal" or "multi", or the scene has no frame of it.
+    TypeError
+        If ``scene`` is not a :class:`MethodInput` (a ``Scene`` holds the truth).
     """
+    require_method_input(scene, "a 2D method")
     if protocol not in VIEW_PROTOCOLS:
         raise ValueError(f"unknown view protocol {protocol!r}; expected one of {VIEW_PROTOCOLS}")
     if depth not in ("required", "optional", "no"):
@@ -132,12 +136,12 @@ def load_views(scene: Scene, protocol: Protocol, *, depth: Literal["required", "
     return out
 
 
-def _read_labels(scene: Scene, frame: Frame) -> np.ndarray:
+def _read_labels(scene: MethodInput, frame: Frame) -> np.ndarray:
     if frame.semantic_file_path is None:
         raise ViewError("the frame has no semantic_file_path (semantic mask) in transforms.json")
     return read_frame_labels(scene, frame)
 
 
-def _read_depth(scene: Scene, frame: Frame, labels: np.ndarray) -> np.ndarray:
+def _read_depth(scene: MethodInput, frame: Frame, labels: np.ndarray) -> np.ndarray:
     """Raises plain ValueError (not ViewError) so that callers decide whether depth matters."""
     return read_frame_depth_m(scene, frame, labels)

@@ -29,8 +29,9 @@ from baselines.facade_mask import facade_class_mask, isolate_facade_2ds
 from baselines.views import FacadeView, Protocol, ViewError, load_views
 from dataset.core.classes import SemanticClass
 from dataset.core.cli_errors import check_output_folder
+from dataset.core.method_input import MethodInput
 from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.scene_record import Scene, scene_name
+from dataset.core.scene_record import scene_name
 from dataset.core.wwr import wwr_from_areas
 
 METHOD = "2D-S"
@@ -106,7 +107,7 @@ def measure_view_2ds(view: FacadeView, config: Wwr2dsConfig) -> tuple[ViewPixels
     return ViewPixels2ds(wwr, window_px, facade_px, pixel_area, mask), warning
 
 
-def run_2ds(scene: Scene, protocol: Protocol, config: Wwr2dsConfig = Wwr2dsConfig(), *,
+def run_2ds(scene: MethodInput, protocol: Protocol, config: Wwr2dsConfig = Wwr2dsConfig(), *,
             debug_dir: Path | None = None) -> MethodResult:
     """2D-S on one scene's ideal or multi views.
 

@@ -64,8 +64,9 @@ from baselines.views import FacadeView, Protocol, ViewError, load_views
 from dataset.core.camera import Intrinsics
 from dataset.core.cli_errors import check_output_folder
 from dataset.core.device import resolve_device
+from dataset.core.method_input import MethodInput
 from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Scene, scene_name
+from dataset.core.scene_record import scene_name
 from dataset.scenes.images import read_rgb
 
 METHOD = "2D-SS"
@@ -234,7 +235,7 @@ def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
     return wwr, images
 
 
-def run_2dss(scene: Scene, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssConfig(), *,
+def run_2dss(scene: MethodInput, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssConfig(), *,
              debug_dir: Path | None = None, device: torch.device | str = "cpu") -> MethodResult:
     """2D-SS on one scene's ideal or multi views.
 
@@ -246,7 +247,7 @@ def run_2dss(scene: Scene, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssCo
     start = time.perf_counter()
     loaded = load_views(scene, protocol, depth="required")
     geometries: list[ViewGeometry] = []
-    step = float(scene.extra.get(DEPTH_RELATIVE_STEP_KEY, 0.0))
+    step = scene.depth_relative_step
     for n, view in enumerate(loaded.views):
         try:
             geometries.append(measure_view_geometry(
@@ -289,7 +290,7 @@ def _facade_estimate(fid: int, ms: list[tuple[ViewGeometry, float]],
                           width_m=length, height_m=height, views_used=len(ms))
 
 
-def _write_debug(folder: Path, scene: Scene, protocol: str, geometries: list[ViewGeometry],
+def _write_debug(folder: Path, scene: MethodInput, protocol: str, geometries: list[ViewGeometry],
                  rectified: list[np.ndarray | None]) -> None:
     for g, rect in zip(geometries, rectified):
         v = g.view

@@ -45,9 +45,9 @@ from baselines.wwr2dss import (  # noqa: E402
     run_2dss,
 )
 from dataset.core.atomic import write_text_atomic  # noqa: E402
+from dataset.core.method_input import MethodInput  # noqa: E402
 from dataset.core.protocols import VIEW_PROTOCOLS  # noqa: E402
-from dataset.core.scene_record import Scene  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
 from metrics.aggregate import aggregate_by_family  # noqa: E402
 from metrics.errors import building_errors, failed_building  # noqa: E402
 from metrics.report import table2_errors  # noqa: E402
@@ -57,7 +57,7 @@ SPEED_SIZE = 512
 PROTOCOLS = VIEW_PROTOCOLS
 
 
-def speed_section(scenes: list[Scene], repeat: int) -> str:
+def speed_section(scenes: list[MethodInput], repeat: int) -> str:
     """Markdown lines with views/s of both methods (compute only, and end to end)."""
     views_2ds = [v for s in scenes for p in PROTOCOLS
                  for v in load_views(s, p, depth="optional").views]
@@ -108,8 +108,8 @@ def error_section(folders: list[Path]) -> str:
     """Markdown Table 2 (APE mean ± std per family) for both methods and protocols."""
     rows = []
     for folder in folders:
-        scene = read_scene(folder)
-        truth = scene.building
+        truth = read_scene(folder).building
+        scene = read_method_input(folder)
         for method, run in (("2D-S", run_2ds), ("2D-SS", run_2dss)):
             for p in PROTOCOLS:
                 try:
@@ -133,8 +133,8 @@ def _best_of(fn, repeat: int) -> tuple[float, float]:
     return min(wall), min(cpu)
 
 
-def _scenes_at(folders: list[Path], size: int) -> list[Scene]:
-    scenes = [read_scene(f) for f in folders]
+def _scenes_at(folders: list[Path], size: int) -> list[MethodInput]:
+    scenes = [read_method_input(f) for f in folders]
     return [s for s in scenes
             if s.frames and (s.frames[0].intrinsics.width, s.frames[0].intrinsics.height)
             == (size, size)]

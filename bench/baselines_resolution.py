@@ -30,16 +30,17 @@ from tqdm import tqdm  # noqa: E402
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
 from dataset.core.mesh import read_labelled_ply  # noqa: E402
+from dataset.core.method_input import MethodInput  # noqa: E402
 from dataset.core.protocols import VIEW_PROTOCOLS  # noqa: E402
 from dataset.core.scene_record import Frame, Scene  # noqa: E402
 from dataset.rendering.render import Raycaster, render_ground_truth  # noqa: E402
 from dataset.scenes.images import write_depth_m, write_labels  # noqa: E402
-from dataset.scenes.scene import read_scene, write_transforms  # noqa: E402
+from dataset.scenes.scene import read_method_input, read_scene, write_transforms  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 
 
 def rerendered_scene(scene: Scene, raycaster: Raycaster, protocol: str, factor: int,
-                     root: Path) -> Scene:
+                     root: Path) -> MethodInput:
     """The scene's ``protocol`` views rendered at ``factor`` times the resolution, in ``root``."""
     frames = []
     for n, frame in enumerate(scene.frames_in(protocol)):
@@ -53,7 +54,7 @@ def rerendered_scene(scene: Scene, raycaster: Raycaster, protocol: str, factor: 
                             semantic_file_path=f"semantics/{stem}"))
     out = replace(scene, root=root, frames=tuple(frames), building=None)
     write_transforms(root, out)
-    return read_scene(root)
+    return read_method_input(root)
 
 
 def main(argv: list[str] | None = None) -> int:

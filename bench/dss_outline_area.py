@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 
 
@@ -37,10 +37,10 @@ def main() -> None:
     totals: dict[tuple[str, str], list[tuple[float, float, float]]] = {}
     print(f"{'scene':22s} {'views':6s} {'variant':8s} facade% window%   WWR%")
     for folder in scene_folders(args.data):
-        scene = read_scene(folder)
+        truth, scene = read_scene(folder).building, read_method_input(folder)
         for protocol in args.views.split(","):
             for name, config in configs.items():
-                e = building_errors(run_2dss(scene, protocol, config), scene.building)
+                e = building_errors(run_2dss(scene, protocol, config), truth)
                 row = (e.facade_ape, e.window_ape, e.wwr_ape)
                 totals.setdefault((protocol, name), []).append(row)
                 print(f"{folder.name:22s} {protocol:6s} {name:8s} "

@@ -39,7 +39,7 @@ import torch  # noqa: E402
 
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.device import resolve_device  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
 from neural3d.field.trained import TrainedField, build_field  # noqa: E402
 from neural3d.train import train  # noqa: E402
@@ -60,7 +60,7 @@ def training_steps(scene_dir: Path, config: TrainConfig, device: torch.device
     """``step(i)``: training step ``i`` (``train_step``, weight averaging included) of a fresh
     field on ``scene_dir``'s train frames, as ``neural3d.train`` runs it; synchronised on CUDA.
     """
-    scene = read_scene(scene_dir)
+    scene = read_method_input(scene_dir)  # never the truth, as in neural3d.train
     bg = background_class(scene)
     frames = load_frames(scene, "train", image_scale=config.image_scale)
     norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)

@@ -9,7 +9,7 @@ For every run a comparison kept (``DIR/neural3d_runs/<scene>/``, DIR being
 ``--resolution``) and measured twice with the comparison's ``MeasureConfig``:
 each triangle's facade area split among wall, window and door by its corners'
 argmax labels, and by their class probabilities
-(:mod:`neural3d.extraction.facade_split`, ``ExtractConfig.soft_facade_split``).
+(:mod:`neural3d.extraction.facade_split`, ``MeasureStages.probability_split``).
 Prints, in Markdown, per building and per family, the window, facade and WWR
 errors (APE %) of both against the scene's truth.
 """

@@ -1,12 +1,14 @@
 """Generate benchmark scene folders: ``python -m dataset.generate --preset tiny --out data/tiny``.
 
-One scene folder per building, named by the building id, written by
-:func:`dataset.scenes.scene_writer.generate_scene` (atomically: a folder with the
-final name is always finished). This module runs a whole preset (optionally
-in several processes, one building each) or a user's mesh, and is the CLI.
-A rerun skips finished scenes whose provenance record (config, seed, inputs,
-code) matches, so an interrupted run resumes where it stopped, and a scene made
-by older code is re-rendered with the reason logged.
+The scenes come from one source of :data:`dataset.sources.SOURCES` (a preset, a labelled
+mesh, an IFC model, an official BuildNet3D layout; :mod:`dataset.importers.source`). One
+scene folder per entry, named by the entry: a building is rendered by
+:func:`dataset.scenes.scene_writer.generate_scene` (optionally in several processes, one
+building each, or on a Ray cluster), a scene the source has already rendered is written as
+it is; both atomically (a folder with the final name is always finished). A rerun skips
+finished buildings whose provenance record (config, seed, inputs, code) matches, so an
+interrupted run resumes where it stopped, and a scene made by older code is re-rendered with
+the reason logged. This module is also the CLI.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import argparse
 import shutil
 import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +28,7 @@ from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.core.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
 from dataset.executors.ray_tasks import RayConfig, add_executor_arguments
 from dataset.executors.worker_pool import worker_pool
-from dataset.importers.import_config import add_import_arguments
+from dataset.importers.source import BuildingEntry, Entry, NoOptions, SceneEntry, write_scenes
 from dataset.scenes.scene_writer import (
     GenerateConfig,
     PlannedView,
@@ -37,11 +39,19 @@ from dataset.scenes.scene_writer import (
     scene_changes,
     scene_is_finished,
 )
+from dataset.source_args import (
+    add_import_arguments,
+    add_source_arguments,
+    chosen_source,
+    source_options,
+)
+from dataset.sources import PRESET_SOURCE, SOURCES
 
 __all__ = [
     "GenerateConfig",
     "PlannedView",
     "depth_unit_for",
+    "generate_entries",
     "generate_preset",
     "generate_scene",
     "main",
@@ -61,43 +71,62 @@ def generate_preset(
     overwrite: bool = False, progress: bool = True, ray: RayConfig | None = None,
     log: Callable[[str], None] = tqdm.write,
 ) -> list[Path]:
-    """Generate every building of preset ``name`` into ``out_root``; return the scene folders.
-
-    Resumable: scenes whose provenance record matches what this code would write
-    (config, seed, recipe, dataset code, libraries) are skipped; a scene that
-    differs only by the code that made it is re-rendered, with the reason logged.
-    ``workers`` processes each build and render one building at a time (a single
-    building left to do has its frames split over them instead). With ``ray``
-    each building is a task on that Ray cluster instead (:mod:`dataset.ray_generate`).
+    """Generate every building of preset ``name`` into ``out_root``; return the scene folders
+    (:func:`generate_entries` of :data:`dataset.sources.PRESET_SOURCE`'s entries).
 
     Raises
     ------
     ValueError
-        Unknown preset, ``workers < 1``, unwritable ``out_root``, a scene folder
-        made with another config, seed or recipe, or by code too old to say
-        (pass ``overwrite=True`` to replace it),
-        or a building that cannot be framed.
+        Unknown preset, and as :func:`generate_entries`.
     """
-    from dataset.presets import preset_recipes
+    return generate_entries(PRESET_SOURCE.read(name, NoOptions()), out_root, config,
+                            workers=workers, seed=seed, overwrite=overwrite, progress=progress,
+                            ray=ray, log=log, desc=f"preset {name}")
 
+
+def generate_entries(
+    entries: Sequence[Entry], out_root: str | Path, config: GenerateConfig, *, workers: int = 1,
+    seed: int = 0, overwrite: bool = False, progress: bool = True, ray: RayConfig | None = None,
+    log: Callable[[str], None] = tqdm.write, desc: str = "buildings",
+) -> list[Path]:
+    """Make a scene folder ``out_root / entry.name`` of every entry of a source; return them.
+
+    A :class:`~dataset.importers.source.SceneEntry` is written as its source rendered it
+    (kept if there, unless ``overwrite``). A building is rendered resumably: scenes whose
+    provenance record matches what this code would write (config, seed, the entry's
+    inputs, dataset code, libraries) are skipped; a scene that differs only by the code
+    that made it is re-rendered, with the reason logged. A building's seed is ``seed`` mixed
+    with the entry's own (:func:`scene_seed`), or ``seed`` itself. ``workers`` processes each
+    build and render one building at a time (a single building left to do has its frames
+    split over them instead). With ``ray`` each building is a task on that Ray cluster
+    instead (:mod:`dataset.ray_generate`).
+
+    Raises
+    ------
+    ValueError
+        ``workers < 1``, unwritable ``out_root``, a scene folder made with another config,
+        seed or inputs, or by code too old to say (pass ``overwrite=True`` to replace it),
+        or a building that cannot be built or framed.
+    """
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
-    recipes = preset_recipes(name)
     out_root = Path(out_root)
     check_writable(out_root)
+    write_scenes([e for e in entries if isinstance(e, SceneEntry)], out_root,
+                 overwrite=overwrite, progress=progress)
+    buildings = [e for e in entries if isinstance(e, BuildingEntry)]
     todo = []
-    for recipe in recipes:
-        s = scene_seed(seed, recipe.seed)
-        scene_dir = out_root / recipe.id
-        _remove_stale_partials(out_root, recipe.id)
-        inputs = {"preset": name, "recipe": recipe.id}
-        changes = scene_changes(scene_dir, config, s, inputs)
+    for entry in buildings:
+        s = seed if entry.seed is None else scene_seed(seed, entry.seed)
+        _remove_stale_partials(out_root, entry.name)
+        inputs = dict(entry.inputs)
+        changes = scene_changes(out_root / entry.name, config, s, inputs)
         if not changes:
             continue
-        _check_replaceable(scene_dir, changes, overwrite, log)
-        todo.append((recipe, out_root, config, s, inputs))
-    bar = tqdm(total=len(recipes), initial=len(recipes) - len(todo), desc=f"preset {name}",
-               unit="building", disable=not progress)
+        _check_replaceable(out_root / entry.name, changes, overwrite, log)
+        todo.append((entry, out_root, config, s, inputs))
+    bar = tqdm(total=len(buildings), initial=len(buildings) - len(todo), desc=desc,
+               unit="building", disable=not progress or not buildings)
     with bar:
         if ray is not None:
             from dataset.ray_generate import generate_on_ray
@@ -108,11 +137,11 @@ def generate_preset(
         elif workers == 1 or len(todo) <= 1:
             for job in todo:
                 # A lone building still uses the workers: its frames are split over them.
-                _generate_recipe(job, progress=progress, workers=workers)
+                _generate_building(job, progress=progress, workers=workers)
                 bar.update()
         else:
             _run_pool(todo, workers, bar)
-    return [out_root / r.id for r in recipes]
+    return [out_root / e.name for e in entries]
 
 
 def check_writable(folder: Path) -> None:
@@ -126,13 +155,10 @@ def check_writable(folder: Path) -> None:
         ) from exc
 
 
-def _generate_recipe(job: tuple, progress: bool = False, workers: int = 1) -> Path:
-    from dataset.presets import build_building
-
-    recipe, out_root, config, s, inputs = job
-    building = build_building(recipe)
-    return generate_scene(building, out_root, config, seed=s, name=recipe.id, progress=progress,
-                          workers=workers, inputs=inputs)
+def _generate_building(job: tuple, progress: bool = False, workers: int = 1) -> Path:
+    entry, out_root, config, s, inputs = job
+    return generate_scene(entry.build(), out_root, config, seed=s, name=entry.name,
+                          progress=progress, workers=workers, inputs=inputs)
 
 
 def _check_replaceable(
@@ -153,7 +179,7 @@ def _check_replaceable(
 def _run_pool(todo: list[tuple], workers: int, bar: tqdm) -> None:
     # Each worker deletes its unfinished scene folder when the pool is terminated.
     with worker_pool(min(workers, len(todo))) as pool:
-        for _ in pool.imap_unordered(_generate_recipe, todo):
+        for _ in pool.imap_unordered(_generate_building, todo):
             bar.update()
 
 
@@ -168,64 +194,55 @@ def _remove_stale_partials(out_root: Path, name: str) -> None:
 
 
 def _parse_args(argv: list[str] | None) -> argparse.Namespace:
-    try:
-        from dataset.presets import PRESETS
-    except ImportError:
-        PRESETS = ("paper", "tiny")
     d = GenerateConfig()
     p = argparse.ArgumentParser(
         prog="python -m dataset.generate",
         description=(
             "Render benchmark scene folders (RGB, z-depth, semantics, normals, facade ids, "
             "transforms.json, building.json, mesh.ply) for a built-in preset or for your own "
-            "labelled mesh. Finished scenes are skipped on a rerun, so an interrupted run "
-            "resumes where it stopped."
+            "building, or import scenes an official BuildNet3D generator rendered. Finished "
+            "scenes are skipped on a rerun, so an interrupted run resumes where it stopped."
         ),
         epilog=(
             "examples: python -m dataset.generate --preset tiny --out data/tiny | "
             "python -m dataset.generate --preset paper --out data/paper --workers 2 | "
             "python -m dataset.generate --mesh house.ply --out data/mine | "
-            "python -m dataset.generate --ifc house.ifc --out data/mine. "
-            "Layout and options: docs/rendering.md."
+            "python -m dataset.generate --ifc house.ifc --out data/mine | "
+            "python -m dataset.generate --input house.ifc --out data/mine. "
+            "Layout and options: docs/rendering.md; sources: docs/importing.md."
         ),
     )
-    src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--preset", choices=PRESETS, help="built-in set of procedural buildings")
-    src.add_argument("--mesh", type=Path, metavar="FILE",
-                     help="your labelled mesh (.ply with per-face label, or .obj/.glb with "
-                          "class-named parts), metres, z up; see docs/importing.md")
-    src.add_argument("--ifc", type=Path, metavar="FILE",
-                     help="an IFC model (ArchiCAD, Revit, ... export); see docs/importing.md")
-    p.add_argument("--ifc-classes", type=Path, metavar="JSON",
-                   help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
-                        '{"IfcCovering": "wall", "IfcRailing": "skip"}')
-    src.add_argument("--buildnet3d", type=Path, metavar="PATH",
-                     help="output of an official BuildNet3D generator: the Blender "
-                          "generator's root or one images/building<i> folder, or a BlenderProc "
-                          "generator/dataparser folder (meta_data.json, images/, semantic(s)/) "
-                          "or a folder of them; one scene per building, as rendered (render "
-                          "options are ignored); see docs/importing.md")
+    add_source_arguments(p.add_mutually_exclusive_group(required=True), SOURCES)
     p.add_argument("--out", type=Path, required=True, metavar="DIR",
                    help="folder that receives one scene folder per building")
-    p.add_argument("--resolution", type=int, default=d.resolution,
-                   help=f"square image size in pixels (default {d.resolution})")
-    p.add_argument("--views", type=int, default=d.views,
-                   help=f"orbit views per building, split train/eval (default {d.views})")
-    p.add_argument("--train-fraction", type=float, default=d.train_fraction,
-                   help=f"share of orbit views used for training (default {d.train_fraction})")
-    p.add_argument("--fov", type=float, default=d.fov_deg,
-                   help=f"field of view in degrees (default {d.fov_deg})")
-    p.add_argument("--supersampling", type=int, default=d.supersampling,
-                   help="RGB anti-aliasing: rays per pixel along each axis (default 1)")
+    render = p.add_argument_group("render options (an official layout's scenes are imported "
+                                  "as rendered: these are ignored)")
+    render.add_argument("--resolution", type=int, default=d.resolution,
+                        help=f"square image size in pixels (default {d.resolution})")
+    render.add_argument("--views", type=int, default=d.views,
+                        help=f"orbit views per building, split train/eval (default {d.views})")
+    render.add_argument("--train-fraction", type=float, default=d.train_fraction,
+                        help="share of orbit views used for training "
+                             f"(default {d.train_fraction})")
+    render.add_argument("--fov", type=float, default=d.fov_deg,
+                        help=f"field of view in degrees (default {d.fov_deg})")
+    render.add_argument("--supersampling", type=int, default=d.supersampling,
+                        help="RGB anti-aliasing: rays per pixel along each axis (default 1)")
+    render.add_argument("--context", action="store_true",
+                        help="render the buildings around each building as occluders in every "
+                             "view (sources that know them: CityGML, the lod3 preset); they are "
+                             "background in the labels and the truth is unchanged "
+                             "(docs/importing.md section 8)")
+    render.add_argument("--seed", type=int, default=0,
+                        help="seed for cameras and looks (default 0)")
     p.add_argument("--workers", type=int, default=1,
-                   help="processes: with --preset each renders one building at a time; with "
-                        "--mesh they share the building's frames (default 1)")
+                   help="processes: with several buildings each renders one building at a "
+                        "time; with one they share its frames (default 1)")
     add_executor_arguments(p, "--workers processes here", "building, with --preset")
-    p.add_argument("--seed", type=int, default=0, help="seed for cameras and looks (default 0)")
     p.add_argument("--overwrite", action="store_true",
                    help="replace scenes that were made with another config or seed")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
-    add_import_arguments(p)  # with --mesh or --ifc
+    add_import_arguments(p)
     add_debug_flag(p)
     return p.parse_args(argv)
 
@@ -237,24 +254,20 @@ def main(argv: list[str] | None = None) -> int:
     def body() -> int:
         config = GenerateConfig(
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
-            fov_deg=args.fov, supersampling=args.supersampling,
+            fov_deg=args.fov, supersampling=args.supersampling, context=args.context,
         )
-        if args.executor == "ray" and args.preset is None:
-            raise ValueError("--executor ray renders a preset's buildings as tasks; with --mesh "
-                             "use --workers to split one building's frames over processes")
+        source, path = chosen_source(args, SOURCES)
+        if args.executor == "ray" and source is not PRESET_SOURCE:
+            raise ValueError("--executor ray renders a preset's buildings as tasks (each node "
+                             "builds its own); with another source use --workers")
         check_output_folder(args.out)
-        if args.buildnet3d is not None:
-            from dataset.importers.official import import_official
-
-            scenes = import_official(args.buildnet3d, args.out, overwrite=args.overwrite)
-        elif args.preset is not None:
-            _check_resources(args, config)
-            ray = RayConfig(address=args.ray_address) if args.executor == "ray" else None
-            scenes = generate_preset(args.preset, args.out, config, workers=args.workers,
-                                     seed=args.seed, overwrite=args.overwrite,
-                                     progress=not args.quiet, ray=ray)
-        else:
-            scenes = [_generate_mesh(args, config)]
+        entries = source.read(path, source_options(source, args, progress=not args.quiet))
+        _check_resources(args, config, sum(isinstance(e, BuildingEntry) for e in entries))
+        ray = RayConfig(address=args.ray_address) if args.executor == "ray" else None
+        scenes = generate_entries(entries, args.out, config, workers=args.workers,
+                                  seed=args.seed, overwrite=args.overwrite,
+                                  progress=not args.quiet, ray=ray,
+                                  desc=f"{source.name} {Path(path).name}")
         for scene in scenes:
             print(scene)
         return 0
@@ -269,32 +282,15 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGTERM, previous)
 
 
-def _check_resources(args: argparse.Namespace, config: GenerateConfig) -> None:
-    from dataset.presets import preset_recipes
-
+def _check_resources(args: argparse.Namespace, config: GenerateConfig, buildings: int) -> None:
+    """Refuse ``--workers`` below 1, and a render of ``buildings`` that would not fit."""
     if args.workers < 1:
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
-    scenes = len(preset_recipes(args.preset)) if args.preset is not None else 1
-    check_generate_resources(config.resolution, config.supersampling,
-                             config.views + FACADE_VIEWS_PER_BUILDING, scenes,
-                             min(args.workers, scenes) if scenes > 1 else args.workers, args.out)
-
-
-def _generate_mesh(args: argparse.Namespace, config: GenerateConfig) -> Path:
-    from dataset.importers.import_source import import_from_args, import_inputs
-
-    building = import_from_args(args)
-    check_writable(args.out)
-    name = building.truth.id
-    _remove_stale_partials(args.out, name)
-    scene_dir = args.out / name
-    inputs = import_inputs(args)
-    changes = scene_changes(scene_dir, config, args.seed, inputs)
-    if not changes:
-        return scene_dir
-    _check_replaceable(scene_dir, changes, args.overwrite, tqdm.write)
-    return generate_scene(building, args.out, config, seed=args.seed, progress=not args.quiet,
-                          workers=args.workers, inputs=inputs)
+    if buildings:
+        check_generate_resources(
+            config.resolution, config.supersampling, config.views + FACADE_VIEWS_PER_BUILDING,
+            buildings, min(args.workers, buildings) if buildings > 1 else args.workers,
+            args.out)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,10 @@
-"""``python -m dataset.importer MESH SCENE_DIR``: import a labelled building mesh as a scene.
+"""``python -m dataset.importer FILE SCENE_DIR``: a building file's truth without rendering.
 
-The import itself is :func:`dataset.importers.mesh_import.import_labelled_mesh`
-(docs/importing.md); this command writes its ``building.json`` and ``mesh.ply``.
+A thin alias of ``python -m dataset.generate``'s import path: the same sources (a labelled
+mesh or an IFC model, told apart by :func:`dataset.importers.source.pick_source`), the same
+import options (:mod:`dataset.source_args`) and the same import
+(:class:`dataset.importers.source.BuildingEntry`); it writes the building's ``mesh.ply`` and
+``building.json`` instead of rendering a scene (docs/importing.md).
 """
 
 from __future__ import annotations
@@ -13,21 +16,26 @@ from pathlib import Path
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
 from dataset.core.mesh import write_labelled_ply
 from dataset.core.truth import write_building
-from dataset.importers.import_config import add_import_arguments, import_config_from_args
-from dataset.importers.mesh_import import import_labelled_mesh
+from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE
+from dataset.importers.source import pick_source
+from dataset.source_args import add_import_arguments, source_options
+
+BUILDING_FILES = (MESH_SOURCE, IFC_SOURCE)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m dataset.importer",
-        description="Import your own labelled building mesh: derive its ground truth (facades, "
-        "window/wall/door areas seen from outside, WWR, footprint) and write building.json and "
-        "mesh.ply (with facade ids) into a scene folder. The mesh is closed bodies (they may "
-        "touch or overlap); label faces with a PLY 'label' property (0 background, 1 wall, "
-        "2 window, 3 roof, 4 door, 5 other) or name OBJ/GLB objects, groups or materials after "
-        "the classes.",
+        description="Import your own building file without rendering it: derive its ground "
+        "truth (facades, window/wall/door areas seen from outside, WWR, footprint) and write "
+        "building.json and mesh.ply (with facade ids) into a scene folder. The file is a "
+        "labelled mesh (closed bodies, which may touch or overlap; label faces with a PLY "
+        "'label' property: 0 background, 1 wall, 2 window, 3 roof, 4 door, 5 other, or name "
+        "OBJ/GLB objects, groups or materials after the classes) or an IFC model. "
+        "`python -m dataset.generate --mesh/--ifc FILE` imports it the same way and renders it.",
     )
-    parser.add_argument("mesh", type=Path, help="labelled mesh: .ply, .obj, .glb or .gltf")
+    parser.add_argument("file", type=Path,
+                        help="labelled mesh (.ply, .obj, .glb, .gltf) or IFC model (.ifc)")
     parser.add_argument("scene_dir", type=Path, help="folder to write building.json and mesh.ply")
     parser.add_argument("--id", dest="building_id", help="building id (default: file name)")
     add_import_arguments(parser)
@@ -35,9 +43,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
 
     def body() -> int:
-        config = import_config_from_args(args)
+        source = pick_source(BUILDING_FILES, args.file) if args.file.is_file() else MESH_SOURCE
+        (entry,) = source.read(args.file, source_options(source, args,
+                                                         building_id=args.building_id))
         check_output_folder(args.scene_dir, "scene_dir")
-        building = import_labelled_mesh(args.mesh, building_id=args.building_id, config=config)
+        building = entry.build()
         write_labelled_ply(args.scene_dir / "mesh.ply", building.mesh)
         write_building(args.scene_dir / "building.json", building.truth)  # last: marks done
         t = building.truth

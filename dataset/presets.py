@@ -6,7 +6,13 @@ a model; :func:`build_building` turns it into mesh + truth deterministically
 
 - ``paper``: 12 skyscrapers, 12 L-shaped buildings and the four realistic models;
 - ``tiny``: one small building per family (a 9-storey skyscraper, a 4-storey L-shape
-  and the realistic house), cheap to render, for tests and defaults.
+  and the realistic house), cheap to render, for tests and defaults;
+- ``heldout``: buildings nothing is tuned on (``docs/metrics.md``): six skyscrapers and
+  six L-shaped buildings at seeds outside the ``paper`` preset's, and the eight held-out
+  designs of :mod:`dataset.families.heldout` (family realistic);
+- ``lod3``: 49 real buildings, the Ingolstadt LoD3 CityGML models that have windows
+  (family ``citygml``; files in ``dataset/examples/lod3_ingolstadt``, CC BY-SA 4.0,
+  :mod:`dataset.importers.citygml_preset`).
 
 Run ``python -m dataset.presets`` to print the ranges a preset spans.
 """
@@ -23,14 +29,16 @@ from tqdm import tqdm
 
 from dataset.core.cli_errors import add_debug_flag, run_cli
 from dataset.core.truth import Building, BuildingTruth
+from dataset.families.heldout import make_heldout, sample_heldout_params
+from dataset.families.heldout_params import HELDOUT_MODELS
 from dataset.families.l_shaped import make_l_shaped, sample_l_shaped_params
 from dataset.families.realistic import make_realistic, sample_realistic_params
 from dataset.families.realistic_params import REALISTIC_MODELS
 from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_params
 
-Family = Literal["skyscraper", "l_shaped", "realistic"]
-FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic")
-PRESETS = ("paper", "tiny")
+Family = Literal["skyscraper", "l_shaped", "realistic", "citygml"]
+FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "citygml")
+PRESETS = ("paper", "tiny", "heldout", "lod3")
 _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 # Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
@@ -45,11 +53,19 @@ _PAPER_SEEDS = {
     "l_shaped": (2000, 2001, 2002, 2003, 2004, 2005, 2006, 2040, 2046, 2060, 2122, 2143),
 }
 _REALISTIC_SEED = 3000
+# Seeds of the heldout preset: the first six from 5000 (6000) with no picking, outside the
+# paper preset's candidates (1000-1199, 2000-2199) and the tiny preset's; the held-out designs
+# from 7000.
+_HELDOUT_SEEDS = {"skyscraper": tuple(range(5000, 5006)), "l_shaped": tuple(range(6000, 6006))}
+_HELDOUT_DESIGN_SEED = 7000
+_LOD3_SEED = 4000  # + the building's index: cameras and looks of the lod3 scenes
 
 
 @dataclass(frozen=True)
 class BuildingRecipe:
-    """How to build one building: ``id`` (file-system safe), family, seed, realistic model."""
+    """How to build one building: ``id`` (file-system safe), family, seed, and ``model``: the
+    realistic model (one of the realistic family's models or of the held-out designs), or a
+    ``citygml`` building's file in the lod3 data folder."""
 
     id: str
     family: Family
@@ -64,13 +80,17 @@ class BuildingRecipe:
             )
         if self.family not in FAMILIES:
             raise ValueError(f"unknown family {self.family!r}; choose one of {', '.join(FAMILIES)}")
-        if self.family == "realistic" and self.model not in REALISTIC_MODELS:
+        if self.family == "realistic" and self.model not in (*REALISTIC_MODELS,
+                                                             *HELDOUT_MODELS):
             raise ValueError(
-                f"a realistic recipe needs model one of {', '.join(REALISTIC_MODELS)}, "
-                f"got {self.model!r}"
+                f"a realistic recipe needs model one of "
+                f"{', '.join((*REALISTIC_MODELS, *HELDOUT_MODELS))}, got {self.model!r}"
             )
-        if self.family != "realistic" and self.model is not None:
-            raise ValueError(f"only realistic recipes take a model, got model={self.model!r}")
+        if self.family == "citygml" and not self.model:
+            raise ValueError("a citygml recipe needs model = its file in the lod3 data folder")
+        if self.family not in ("realistic", "citygml") and self.model is not None:
+            raise ValueError(f"only realistic and citygml recipes take a model, got "
+                             f"model={self.model!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, int | np.integer) or (
             self.seed < 0
         ):
@@ -97,6 +117,22 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
             for k, m in enumerate(REALISTIC_MODELS)
         ]
         return tuple(recipes)
+    if name == "heldout":
+        recipes = [
+            BuildingRecipe(f"heldout_{family}_{i:02d}", family, seed)
+            for family in ("skyscraper", "l_shaped")
+            for i, seed in enumerate(_HELDOUT_SEEDS[family])
+        ]
+        recipes += [
+            BuildingRecipe(f"heldout_{m}", "realistic", _HELDOUT_DESIGN_SEED + k, m)
+            for k, m in enumerate(HELDOUT_MODELS)
+        ]
+        return tuple(recipes)
+    if name == "lod3":
+        from dataset.importers.citygml_preset import lod3_entries
+
+        return tuple(BuildingRecipe(e.id, "citygml", _LOD3_SEED + k, e.file)
+                     for k, e in enumerate(lod3_entries()))
     raise ValueError(f"unknown preset {name!r}; choose one of {', '.join(PRESETS)}")
 
 
@@ -104,6 +140,10 @@ def build_building(recipe: BuildingRecipe) -> Building:
     """Mesh and exact truth of ``recipe`` (same recipe -> identical mesh and truth)."""
     if not isinstance(recipe, BuildingRecipe):
         raise ValueError(f"build_building needs a BuildingRecipe, got {type(recipe).__name__}")
+    if recipe.family == "citygml":
+        from dataset.importers.citygml_preset import build_lod3_building
+
+        return build_lod3_building(recipe.id, recipe.model)
     rng = np.random.default_rng(recipe.seed)
     if recipe.family == "skyscraper":
         params = sample_skyscraper_params(rng)
@@ -111,6 +151,9 @@ def build_building(recipe: BuildingRecipe) -> Building:
     if recipe.family == "l_shaped":
         params = sample_l_shaped_params(rng)
         return make_l_shaped(params, building_id=recipe.id, seed=recipe.seed)
+    if recipe.model in HELDOUT_MODELS:
+        return make_heldout(sample_heldout_params(rng, recipe.model), building_id=recipe.id,
+                            seed=recipe.seed)
     params = sample_realistic_params(rng, recipe.model)
     return make_realistic(params, building_id=recipe.id, seed=recipe.seed)
 

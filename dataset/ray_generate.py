@@ -1,6 +1,7 @@
 """Render a preset's buildings on a Ray cluster: one task per building, no shared folder.
 
-Each task builds its building from the recipe, renders the scene folder into
+Each task builds its building from its entry (:class:`dataset.importers.source.BuildingEntry`:
+a preset's recipe, nothing read from this machine's files), renders the scene folder into
 a temporary folder on the worker and returns it packed
 (:mod:`dataset.executors.folder_pack`); this process unpacks it into ``out_root``
 atomically, so a folder with the final name is always finished, and a rerun
@@ -13,24 +14,21 @@ from __future__ import annotations
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from dataset.core.atomic import atomic_directory
 from dataset.executors.folder_pack import pack_folder, unpack_folder
 from dataset.executors.ray_tasks import RayConfig, TaskLost, TaskResources, ray_session, run_tasks
+from dataset.importers.source import BuildingEntry
 from dataset.scenes.scene_writer import GenerateConfig, generate_scene
-
-if TYPE_CHECKING:
-    from dataset.presets import BuildingRecipe
 
 RENDER_RESOURCES = TaskResources(cpus=1.0)  # embree renders a building on one core here
 
 
 def generate_on_ray(
-    recipes: Sequence[BuildingRecipe], out_root: Path, config: GenerateConfig, seeds: Sequence[int],
-    inputs: Sequence[dict], ray: RayConfig,
+    entries: Sequence[BuildingEntry], out_root: Path, config: GenerateConfig,
+    seeds: Sequence[int], inputs: Sequence[dict], ray: RayConfig,
 ) -> Iterator[Path]:
-    """Render ``recipes[i]`` with ``seeds[i]`` into ``out_root / recipe.id`` (``inputs[i]``
+    """Render ``entries[i]`` with ``seeds[i]`` into ``out_root / entry.name`` (``inputs[i]``
     goes into its provenance record); yield each scene folder as it is written, in the order
     the tasks finish.
 
@@ -40,23 +38,21 @@ def generate_on_ray(
         If a building fails to render (its reason), or Ray cannot start.
     """
     with ray_session(ray):
-        calls = [((recipe, config, seed, made_from), RENDER_RESOURCES)
-                 for recipe, seed, made_from in zip(recipes, seeds, inputs)]
+        calls = [((entry, config, seed, made_from), RENDER_RESOURCES)
+                 for entry, seed, made_from in zip(entries, seeds, inputs)]
         for i, value in run_tasks(_render_packed, calls, max_retries=ray.max_retries):
             if isinstance(value, TaskLost):
-                raise ValueError(f"building {recipes[i].id}: {value.reason}")
-            with atomic_directory(out_root / recipes[i].id) as tmp:
+                raise ValueError(f"building {entries[i].name}: {value.reason}")
+            with atomic_directory(out_root / entries[i].name) as tmp:
                 unpack_folder(value, tmp)
-            yield out_root / recipes[i].id
+            yield out_root / entries[i].name
 
 
 def _render_packed(
-    recipe: BuildingRecipe, config: GenerateConfig, seed: int, inputs: dict
+    entry: BuildingEntry, config: GenerateConfig, seed: int, inputs: dict
 ) -> bytes:
-    """On a worker: the recipe's scene folder, rendered in a temporary folder, packed."""
-    from dataset.presets import build_building
-
+    """On a worker: the entry's scene folder, rendered in a temporary folder, packed."""
     with tempfile.TemporaryDirectory(prefix="envelope-bench-") as tmp:
-        scene_dir = generate_scene(build_building(recipe), tmp, config, seed=seed,
-                                   name=recipe.id, progress=False, inputs=inputs)
+        scene_dir = generate_scene(entry.build(), tmp, config, seed=seed, name=entry.name,
+                                   progress=False, inputs=inputs)
         return pack_folder(scene_dir)

@@ -32,7 +32,7 @@ from dataset.core.method import available_methods
 from dataset.core.results import code_version
 from dataset.core.truth import BuildingTruth, read_building
 from dataset.executors.ray_tasks import RayConfig
-from metrics.aggregate import aggregate_by_family
+from metrics.aggregate import GroupSummary, aggregate_by_family
 from metrics.benchmark_cache import ensure_benchmark
 from metrics.compare_args import CompareRequest, compare_request, parse_compare_args
 from metrics.degraded import degraded_run, with_degradation
@@ -49,6 +49,11 @@ from metrics.explain import explain, methods_provenance_text, recorded_steps, ru
 from metrics.html_report import write_report
 from metrics.mesh_pointers import write_mesh_pointers
 from metrics.methods import list_methods, method_specs
+from metrics.orientation_errors import (
+    orientation_errors_of,
+    orientation_table,
+    summarise_orientations,
+)
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report import (
     per_building_table,
@@ -57,6 +62,14 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
+from metrics.report_paper import (
+    PAPER_TABLE2_NAME,
+    PAPER_TABLE3_NAME,
+    paper_table2_comparison,
+    paper_table3_comparison,
+)
+from metrics.report_seeds import SEED_TABLE_NAME, seed_spread_table
+from metrics.report_visible import TABLE2_VISIBLE_NAME, table2_visible_errors
 from metrics.robustness import RobustnessStudy, robustness_table, run_study
 from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
 from metrics.tables import Table, to_csv, to_text, write_table
@@ -65,6 +78,7 @@ PROVENANCE_FILE = "provenance.json"
 PIPELINE_FOLDER = "2dss_pipeline"
 FOOTPRINTS_FOLDER = "footprints"
 PLOTS_FOLDER = "plots"
+CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME)
 
 
 @dataclass(frozen=True)
@@ -76,6 +90,7 @@ class Comparison:
     table2: Table
     table3: Table
     outcomes: tuple[Outcome, ...]
+    more_tables: tuple[Table, ...] = ()  # against the visible truth, seed spread, the paper's
 
 
 def compare(
@@ -117,12 +132,19 @@ def compare(
         table2=replace(table2, notes=(*table2.notes, footer)),
         table3=replace(table3, notes=(*table3.notes, footer)),
         outcomes=tuple(outcomes),
+        more_tables=claims_tables(groups),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
     comment = f"produced by `{command}`; {footer}"
     out_dir.mkdir(parents=True, exist_ok=True)
-    for table in (comparison.table2, comparison.table3):
+    orientation = orientation_table(summarise_orientations(orientation_errors_of(
+        (o.result, truths.get(o.scene)) for o in outcomes if o.result is not None)))
+    for table in (comparison.table2, comparison.table3, *comparison.more_tables,
+                  replace(orientation, notes=(*orientation.notes, footer))):
         write_table(table, out_dir, comment)
+    for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
+        for suffix in (".csv", ".md", ".tex"):  # a table with no rows this time: none stale
+            (out_dir / f"{name}{suffix}").unlink(missing_ok=True)
     for table in (per_building_table(rows), per_facade_table(facade_rows),
                   timing_table(run_timings(outcomes))):
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
@@ -136,6 +158,15 @@ def compare(
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
     _write_html_report(out_dir)
     return comparison
+
+
+def claims_tables(groups: Sequence[GroupSummary]) -> tuple[Table, ...]:
+    """Table 2 against the full and the visible facade truth, the seed-to-seed spread (when
+    a method ran with several seeds) and ours beside the BuildNet3D paper's Tables 2 and 3
+    (each only when it has a row)."""
+    tables = (table2_visible_errors(groups), seed_spread_table(groups),
+              paper_table2_comparison(groups), paper_table3_comparison(groups))
+    return tuple(t for t in tables if t is not None and t.rows)
 
 
 def evaluate(
@@ -298,8 +329,8 @@ def compare_once(request: CompareRequest, command: str, *, allow_run: bool, reus
     comparison = compare(data, specs, results, out, allow_run=allow_run,
                          reuse_stale=reuse_stale, command=command, execute=execute)
     print()
-    print(to_text(comparison.table2))
-    print(to_text(comparison.table3))
+    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
+        print(to_text(table))
     print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
           f"(results in {results}); {time.perf_counter() - start:.0f} s")
     return 0
@@ -321,14 +352,16 @@ def explain_one(request: CompareRequest, scene: str, method: str) -> int:
     scene_dir = next((d for d in find_scenes(request.data) if d.name == scene), None)
     if scene_dir is None:
         raise ValueError(f"no scene {scene!r} in {request.data}")
-    (spec,) = method_specs((method,), request.views, request.results, configs=request.configs)
-    print(explain(scene_dir, spec, request.results))
+    for spec in method_specs((method,), request.views, request.results,
+                             configs=request.configs, seeds=request.seeds):
+        print(explain(scene_dir, spec, request.results))
     return 0
 
 
 def _specs(request: CompareRequest, results: Path) -> list[MethodSpec]:
     """The specs of the request's methods, keeping their artefacts under ``results``."""
-    return method_specs(request.methods, request.views, results, configs=request.configs)
+    return method_specs(request.methods, request.views, results, configs=request.configs,
+                        seeds=request.seeds)
 
 
 def _prepare(request: CompareRequest, comparisons: int = 1) -> None:

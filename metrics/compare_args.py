@@ -37,6 +37,7 @@ class CompareRequest:
     configs: dict[str, Any]
     default: DefaultBenchmark | None
     degradation: tuple[DegradeSpec, ...]
+    seeds: tuple[int, ...] = (0,)
 
 
 def parse_compare_args(argv: Sequence[str] | None,
@@ -67,6 +68,12 @@ def parse_compare_args(argv: Sequence[str] | None,
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,
                         help="folder for tables, plots, provenance (default: <data>-compare)")
+    parser.add_argument("--seeds", default="0",
+                        help="comma-separated training seeds of the methods whose config has a "
+                        "seed (neural3d): one result per seed and building (seed k > 0 in "
+                        "<scene>__<method>__<protocol>__seed<k>.json); the tables average a "
+                        "building's seeds, then bootstrap over buildings, and report the "
+                        "seed-to-seed spread (default: 0)")
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--degrade", metavar="NAME[:SEVERITY],...",
                         help="compare on degraded inputs (truth unchanged): "
@@ -101,6 +108,24 @@ def parse_compare_args(argv: Sequence[str] | None,
     return parser.parse_args(argv)
 
 
+def parse_seeds(text: str) -> tuple[int, ...]:
+    """``--seeds``: distinct non-negative integers, in the order given.
+
+    Raises
+    ------
+    ValueError
+        If an entry is not a non-negative integer or repeats.
+    """
+    try:
+        seeds = tuple(int(s) for s in text.split(",") if s.strip())
+    except ValueError:
+        raise ValueError(f"--seeds must be comma-separated integers, got {text!r}") from None
+    if not seeds or min(seeds) < 0 or len(set(seeds)) != len(seeds):
+        raise ValueError(f"--seeds needs distinct non-negative integers, got {text!r}")
+    return seeds
+
+
+
 def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> CompareRequest:
     """What ``args`` asks to compare. Without ``--data``, the built-in default's folder
     (not generated here); ``--results`` and ``--out`` default to ``<data>-results`` and
@@ -124,7 +149,8 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
         data=data, results=args.results or data.with_name(f"{data.name}-results"),
         out=args.out or data.with_name(f"{data.name}-compare"), methods=names,
         views=_listed(args.views), configs=configs, default=default,
-        degradation=parse_specs(args.degrade, seed=args.degrade_seed) if args.degrade else ())
+        degradation=parse_specs(args.degrade, seed=args.degrade_seed) if args.degrade else (),
+        seeds=parse_seeds(args.seeds))
 
 
 def _listed(text: str) -> tuple[str, ...]:

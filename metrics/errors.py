@@ -3,7 +3,10 @@
 The paper's error is the absolute percentage error, ``100 * |est - true| / true``,
 applied to the WWR (the paper's "mean absolute percentage error" once averaged),
 to the window area ("window" error) and to the gross facade area ("wall" error).
-Footprints are compared by intersection over union of their polygons.
+Footprints are compared by intersection over union of their polygons. Where the truth
+records the facade seen straight on (:meth:`dataset.core.truth.BuildingTruth.visible_areas_m2`),
+the same errors are also taken against it (``*_ape_visible``): a method that measures what it
+sees is not charged for wall hidden behind a railing.
 """
 
 from __future__ import annotations
@@ -77,6 +80,10 @@ class BuildingErrors:
     without one); ``marks`` lists what a reader must know about the figure
     (:data:`CUT_SHORT`, :data:`STALE`), joined by ``"; "``. Timing is kept
     apart (:class:`RunTiming`), so these rows are the same on every rerun.
+    ``seed``: the training seed of a method trained from random weights (``None``:
+    not one); several rows of one (scene, method, protocol) differ by it.
+    ``*_ape_visible``: the errors against the facade seen straight on (``None`` where
+    the truth lacks it).
     """
 
     scene: str
@@ -97,6 +104,10 @@ class BuildingErrors:
     footprint_iou: float | None = None
     steps: int | None = None
     marks: str = ""
+    seed: int | None = None
+    wwr_ape_visible: float | None = None
+    window_ape_visible: float | None = None
+    facade_ape_visible: float | None = None
 
 
 @dataclass(frozen=True)
@@ -156,7 +167,7 @@ def building_errors(
     if result.wwr is None or not math.isfinite(result.wwr):
         reason = "; ".join(result.warnings) or "the method produced no WWR"
         return replace(failed_building(result.scene, family, result.method, result.protocol,
-                                       reason), steps=result.steps, marks=marks)
+                                       reason), steps=result.steps, marks=marks, seed=result.seed)
     reasons: list[str] = []
     iou = None
     if result.footprint is not None and truth is not None:
@@ -192,7 +203,25 @@ def building_errors(
         footprint_iou=iou,
         steps=result.steps,
         marks=marks,
+        seed=result.seed,
+        **visible_errors(result, truth),
     )
+
+
+def visible_errors(result: MethodResult, truth: BuildingTruth | None) -> dict[str, float | None]:
+    """``wwr_ape_visible``, ``window_ape_visible``, ``facade_ape_visible``: the result's
+    errors against the facade seen straight on (all ``None`` where the truth lacks it)."""
+    visible = truth.visible_areas_m2() if truth is not None else None
+    if visible is None:
+        return {"wwr_ape_visible": None, "window_ape_visible": None, "facade_ape_visible": None}
+    notes: list[str] = []  # a truth without visible windows has no percentage error: None
+    return {
+        "wwr_ape_visible": _ape_or_none(result.wwr, visible.wwr, notes, "WWR"),
+        "window_ape_visible": _ape_or_none(result.window_area_m2, visible.window_m2, notes,
+                                           "window"),
+        "facade_ape_visible": _ape_or_none(result.facade_area_m2, visible.gross_m2, notes,
+                                           "facade"),
+    }
 
 
 def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[FacadeErrors, ...]:

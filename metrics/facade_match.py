@@ -15,7 +15,7 @@ truth's ``building.json``:
    so it ranks after every wall with an outline, by normal angle;
 3. several estimates on one truth facade (segments of a curved wall, a wall the
    method split) are merged: window and facade areas add up, WWR is recomputed
-   with :func:`dataset.core.wwr.wwr_from_areas`, widths add and the largest
+   by :class:`dataset.core.wwr.ClassAreas`, widths add and the largest
    height stays;
 4. a truth facade no estimate reaches is reported missing; an estimate whose
    normal agrees with no truth facade is left out with a reason.
@@ -33,7 +33,7 @@ from shapely.geometry import Point, Polygon
 
 from dataset.core.results import FacadeEstimate
 from dataset.core.truth import BuildingTruth
-from dataset.core.wwr import wwr_from_areas
+from dataset.core.wwr import ClassAreas
 
 MAX_NORMAL_ANGLE_DEG = 45.0  # an estimate may face a truth facade only if normals agree this well
 
@@ -144,7 +144,7 @@ def _merge(parts: list[FacadeEstimate], facade_id: int) -> FacadeEstimate:
     heights = [p.height_m for p in parts]
     return FacadeEstimate(
         id=facade_id,
-        wwr=wwr_from_areas(window, gross - window, 0.0),
+        wwr=ClassAreas(window, gross - window, 0.0).wwr,
         window_area_m2=window,
         facade_area_m2=gross,
         width_m=None if None in widths else sum(widths),

@@ -3,8 +3,9 @@
 The built-in ones are found where :data:`dataset.core.method.BUILT_IN` says
 they are declared; any other name is looked up among the installed plugins
 (entry point group ``envelope_bench.methods``). Each becomes a
-:class:`~metrics.runner.MethodSpec` whose ``run`` reads a scene folder and
-returns the method's result. A built-in
+:class:`~metrics.runner.MethodSpec` whose ``run`` reads a scene folder as the
+method's :class:`~dataset.core.method_input.MethodInput` (no truth: metrics alone
+reads ``building.json``) and returns the method's result. A built-in
 method whose package cannot be imported still gets a spec: its runs fail with
 the import error as the reason, and the other methods go on.
 """
@@ -12,6 +13,7 @@ the import error as the reason, and the other methods go on.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import fields, is_dataclass, replace
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -20,7 +22,7 @@ from dataset.core.method import BUILT_IN, Method, built_in_method, installed_met
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.core.results import MethodResult
 from dataset.executors.ray_tasks import TaskResources
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input
 from metrics.runner import MethodSpec
 
 METHODS: tuple[str, ...] = tuple(BUILT_IN)
@@ -32,9 +34,11 @@ def method_specs(
     results_dir: Path,
     *,
     configs: Mapping[str, Any] | None = None,
+    seeds: tuple[int, ...] = (0,),
 ) -> list[MethodSpec]:
     """Specs of the named methods, each run with ``configs[name]`` (default: its config
-    type's default instance); view methods run on ``views``.
+    type's default instance); view methods run on ``views``. A method whose config has a
+    ``seed`` field (neural3d: the training seed) gets one spec per seed of ``seeds``.
 
     Raises
     ------
@@ -50,8 +54,18 @@ def method_specs(
         except ImportError as exc:
             specs.append(_unavailable(name, views, exc))
             continue
-        specs.append(spec_from_method(method, views, results_dir, configs.get(name)))
+        config = configs.get(name)
+        config = method.config_type() if config is None else config
+        if _has_seed(config):
+            specs += [spec_from_method(method, views, results_dir, replace(config, seed=s))
+                      for s in seeds]
+        else:
+            specs.append(spec_from_method(method, views, results_dir, config))
     return specs
+
+
+def _has_seed(config: Any) -> bool:
+    return is_dataclass(config) and any(f.name == "seed" for f in fields(config))
 
 
 def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
@@ -60,11 +74,14 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
 
     It runs on the protocols it declares: of the view protocols, those in
     ``views``; others (``train``) always. A method with an ``artefacts`` folder
-    keeps it under ``results_dir``.
+    keeps it under ``results_dir`` (a seed other than 0 in ``seed<k>/`` below it).
     """
     config = method.config_type() if config is None else config
     protocols = tuple(p for p in method.protocols if p not in VIEW_PROTOCOLS or p in views)
+    seed = config.seed if _has_seed(config) else None
     artefacts_dir = results_dir / method.artefacts if method.artefacts else None
+    if artefacts_dir is not None and seed:
+        artefacts_dir = artefacts_dir / f"seed{seed}"
     run = partial(_run_on_folder, method, config)
     if artefacts_dir is not None:
         run = partial(run, artefacts_dir=artefacts_dir)
@@ -76,18 +93,19 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
                       resources=TaskResources(cpus=cpus, gpus=gpus),
                       artefacts_dir=artefacts_dir, code=("dataset", *method.packages),
                       libraries=method.libraries, mesh_file=method.mesh_file,
-                      heavy=method.heavy, debug_images=debug_images)
+                      heavy=method.heavy, debug_images=debug_images, seed=seed)
 
 
 def _run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
                    **artefacts_dir: Path) -> MethodResult:
-    return method.run(read_scene(scene_dir), protocol, config, **artefacts_dir)
+    return method.run(read_method_input(scene_dir, method.inputs), protocol, config,
+                      **artefacts_dir)
 
 
 def _debug_images_of_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
                             folder: Path) -> None:
     assert method.debug_images is not None
-    method.debug_images(read_scene(scene_dir), protocol, config, folder)
+    method.debug_images(read_method_input(scene_dir, method.inputs), protocol, config, folder)
 
 
 def list_methods() -> list[str]:

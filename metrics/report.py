@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from metrics.aggregate import ALL_FAMILIES, GroupSummary
+from metrics.bootstrap import INTERVAL_TEXT
 from metrics.errors import CUT_SHORT, STALE, BuildingErrors, FacadeErrors, RunTiming
 from metrics.tables import Table, read_csv_rows
 
@@ -31,7 +32,8 @@ def table2_errors(groups: Sequence[GroupSummary]) -> Table:
     )
     return Table(
         name=TABLE2_NAME,
-        title="Absolute percentage error (%) of WWR, window area and facade area, mean ± std",
+        title="Absolute percentage error (%) of WWR, window area and facade area, mean ± std "
+              f"[{INTERVAL_TEXT}]",
         columns=("Family", "Method", "Views", "Buildings", "Failed",
                  "WWR error (%)", "Window error (%)", "Facade error (%)", "Steps", "Marks"),
         keys=("family", "method", "protocol", "buildings", "failed",
@@ -53,7 +55,7 @@ def table3_footprint_iou(
     kept = [g for g in groups if g.method in methods]
     return Table(
         name=TABLE3_NAME,
-        title="Footprint IoU with the ground truth, mean ± std",
+        title=f"Footprint IoU with the ground truth, mean ± std [{INTERVAL_TEXT}]",
         columns=("Family", "Method", "Views", "Buildings", "Failed", "Footprint IoU", "Steps",
                  "Marks"),
         keys=("family", "method", "protocol", "buildings", "failed", "footprint_iou", "steps",

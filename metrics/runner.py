@@ -61,6 +61,8 @@ class MethodSpec:
     ``code`` names the modules or packages whose source the results depend on and
     ``libraries`` the distributions whose versions they depend on: both go into
     each result's provenance record, so changing them recomputes the results.
+    ``seed``: the training seed of a method whose config has one (neural3d); specs
+    that differ only by it keep their results side by side (``__seed<k>`` files).
     """
 
     name: str
@@ -75,6 +77,7 @@ class MethodSpec:
     mesh_file: str | None = None
     heavy: bool = False
     debug_images: Callable[[Path, str, Path], None] | None = None
+    seed: int | None = None
 
 
 @dataclass(frozen=True)
@@ -165,10 +168,10 @@ def run_missing(
     """
     results_dir = Path(results_dir)
     jobs = [Job(s, spec, p) for s in scene_dirs for spec in specs for p in spec.protocols]
-    records = {(j.scene_dir, j.spec.name): expected_provenance(j.scene_dir, j.spec)
+    records = {(j.scene_dir, j.spec.name, j.spec.seed): expected_provenance(j.scene_dir, j.spec)
                for j in jobs}
     outcomes: list[Outcome | None] = [
-        _stored(job, records[job.scene_dir, job.spec.name], results_dir,
+        _stored(job, records[job.scene_dir, job.spec.name, job.spec.seed], results_dir,
                 keep_stale=reuse_stale or not allow_run, allow_run=allow_run, log=log)
         for job in jobs]
     todo = [i for i, o in enumerate(outcomes) if o is None]
@@ -179,7 +182,8 @@ def run_missing(
                 raise RuntimeError(f"the executor returned run {k} twice")
             if outcome.result is not None:
                 job = jobs[todo[k]]
-                result = replace(outcome.result, provenance=records[job.scene_dir, job.spec.name])
+                result = replace(outcome.result, seed=job.spec.seed,
+                                 provenance=records[job.scene_dir, job.spec.name, job.spec.seed])
                 outcome = replace(outcome, result=result, path=write_result(results_dir, result))
             else:
                 log(f"{outcome.scene} / {outcome.method} / {outcome.protocol}: failed: "
@@ -217,7 +221,7 @@ def _stored(job: Job, expected: Provenance, results_dir: Path, *, keep_stale: bo
             allow_run: bool, log: Callable[[str], None]) -> Outcome | None:
     """The outcome of ``job`` without running it, or ``None`` if it has to run."""
     scene, spec, protocol = job.scene_dir.name, job.spec, job.protocol
-    path = results_dir / result_filename(scene, spec.name, protocol)
+    path = results_dir / result_filename(scene, spec.name, protocol, spec.seed)
     why = ""
     if path.is_file():
         try:

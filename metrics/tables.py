@@ -1,9 +1,11 @@
 """A small table type and its writers: CSV, Markdown, LaTeX and plain text for the terminal.
 
 Cells are strings, numbers, :class:`~metrics.aggregate.Summary` (shown as
-``mean ± std``; two columns ``<key>_mean`` and ``<key>_std`` in CSV) or ``None``
-(a missing figure: an empty CSV cell, an en dash elsewhere). Every file starts
-with a comment line saying what produced it.
+``mean ± std`` and, where it has one, its interval ``[low, high]``; columns
+``<key>_mean`` and ``<key>_std``, and ``<key>_low``, ``<key>_high`` where any cell
+of the column has an interval, in CSV) or ``None`` (a missing figure: an empty
+CSV cell, an en dash elsewhere). Every file starts with a comment line saying
+what produced it.
 """
 
 from __future__ import annotations
@@ -55,13 +57,19 @@ class Table:
 
 
 def format_cell(cell: Cell, decimals: int) -> str:
-    """Display text of one cell: ``mean ± std`` for a summary, an en dash for ``None``."""
+    """Display text of one cell: ``mean ± std [low, high]`` for a summary (the std and the
+    interval where it has them), an en dash for ``None``."""
     if cell is None:
         return MISSING
     if isinstance(cell, Summary):
         if cell.mean is None:
             return MISSING
-        return f"{cell.mean:.{decimals}f} ± {cell.std:.{decimals}f}"
+        text = f"{cell.mean:.{decimals}f}"
+        if cell.std is not None:
+            text += f" ± {cell.std:.{decimals}f}"
+        if cell.low is not None and cell.high is not None:
+            text += f" [{cell.low:.{decimals}f}, {cell.high:.{decimals}f}]"
+        return text
     if isinstance(cell, float):
         return f"{cell:.{decimals}f}"
     return str(cell)
@@ -70,15 +78,21 @@ def format_cell(cell: Cell, decimals: int) -> str:
 def to_csv(table: Table, comment: str = "") -> str:
     """CSV text: ``# comment`` lines, a header of keys, rows, then ``# note:`` lines.
 
-    Summaries expand to ``<key>_mean`` and ``<key>_std`` columns with full precision.
+    Summaries expand to ``<key>_mean`` and ``<key>_std`` columns with full precision, and
+    ``<key>_low``, ``<key>_high`` where any summary of the column has an interval.
     Read it back with :func:`read_csv_rows`.
     """
     summary_cols = {
         i for i, _ in enumerate(table.keys) if any(isinstance(r[i], Summary) for r in table.rows)
     }
+    interval_cols = {
+        i for i in summary_cols
+        if any(isinstance(r[i], Summary) and r[i].low is not None for r in table.rows)
+    }
     header: list[str] = []
     for i, key in enumerate(table.keys):
         header += [f"{key}_mean", f"{key}_std"] if i in summary_cols else [key]
+        header += [f"{key}_low", f"{key}_high"] if i in interval_cols else []
     buf = io.StringIO()
     buf.write(_comment_lines("# ", comment))
     writer = csv.writer(buf, lineterminator="\n")
@@ -89,6 +103,7 @@ def to_csv(table: Table, comment: str = "") -> str:
             if i in summary_cols:
                 s = cell if isinstance(cell, Summary) else Summary(None, None, 0)
                 out += [_raw(s.mean), _raw(s.std)]
+                out += [_raw(s.low), _raw(s.high)] if i in interval_cols else []
             else:
                 out.append(_raw(cell))
         writer.writerow(out)
@@ -100,6 +115,14 @@ def read_csv_rows(text: str) -> list[dict[str, str]]:
     """Rows of a CSV written by :func:`to_csv` (comment lines skipped), as dicts of strings."""
     lines = [line for line in text.splitlines() if not line.startswith("#")]
     return list(csv.DictReader(lines))
+
+
+def read_summary(row: dict[str, str], key: str) -> Summary:
+    """The :class:`Summary` a row of :func:`read_csv_rows` holds for ``key`` (its ``_mean``,
+    ``_std`` and, where written, ``_low``/``_high`` columns; count 0: not written)."""
+    values = [row.get(f"{key}_{part}", "") for part in ("mean", "std", "low", "high")]
+    mean, std, low, high = (float(v) if v else None for v in values)
+    return Summary(mean, std, 0, low, high)
 
 
 def to_markdown(table: Table, comment: str = "") -> str:

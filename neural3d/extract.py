@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from dataclasses import asdict, replace
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -35,8 +35,13 @@ from dataset.core.protocols import TRAIN_PROTOCOL
 from dataset.core.resources import check_mesh_resources
 from dataset.core.results import FacadeEstimate, MethodResult, code_version, write_result
 from dataset.core.semantic_ply import write_semantic_ply
-from dataset.core.wwr import wwr_from_areas
-from neural3d.extraction.extract_config import ExtractConfig, footprint_cell_m, footprint_heights_m
+from neural3d.extraction.extract_config import (
+    STAGES,
+    ExtractConfig,
+    footprint_cell_m,
+    footprint_heights_m,
+    without_stages,
+)
 from neural3d.extraction.footprint import footprint_from_sdf
 from neural3d.extraction.measure import MeshMeasurement, measure_semantic_mesh
 from neural3d.extraction.meshing import (
@@ -47,18 +52,17 @@ from neural3d.extraction.meshing import (
     color_vertices,
     extract_mesh,
 )
-from neural3d.extraction.plane_sampling import plane_extents, plane_sampled_areas
-from neural3d.field.chunks import evaluate_in_chunks
 
 METHOD = "neural3d"
 PROTOCOL = TRAIN_PROTOCOL
 
 
 def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
-    """NumPy SDF callable (N, 3) world m -> (N,) m of a ``TrainedField``."""
+    """NumPy SDF callable (N, 3) world m -> (N,) m of a ``TrainedField`` (which evaluates
+    at most ``chunk_points`` points per call of its network)."""
 
     def sdf(points_m: np.ndarray) -> np.ndarray:
-        return _batched(lambda p: trained.sdf_m(p), points_m, device, chunk_points)
+        return _numpy(trained.sdf_m(_tensor(points_m, device), chunk_points=chunk_points))
 
     return sdf
 
@@ -70,7 +74,8 @@ def field_probability_fn(trained, device: torch.device, chunk_points: int):
     class_ids = _class_ids_of(trained.class_names)
 
     def probabilities(points_m: np.ndarray) -> np.ndarray:
-        logits = _batched(lambda p: trained.semantic_logits(p), points_m, device, chunk_points)
+        logits = _numpy(trained.semantic_logits(_tensor(points_m, device),
+                                                chunk_points=chunk_points))
         if logits.ndim != 2 or logits.shape[1] != len(class_ids):
             raise ValueError(f"semantic head gave shape {logits.shape}; expected "
                              f"(N, {len(class_ids)}) for classes {trained.class_names}")
@@ -97,10 +102,8 @@ def field_color_fn(trained, device: torch.device, chunk_points: int) -> ColorFn:
     """NumPy colour callable (points (N, 3), view dirs (N, 3)) -> (N, 3) in [0, 1]."""
 
     def color(points_m: np.ndarray, view_dirs: np.ndarray) -> np.ndarray:
-        both = np.concatenate([points_m, view_dirs], axis=1)
-        # no no_grad here: the colour network may need the SDF gradient (normals) by autograd
-        return _batched(lambda x: trained.rgb(x[:, :3], x[:, 3:]), both, device, chunk_points,
-                        grad=True)
+        both = _tensor(np.concatenate([points_m, view_dirs], axis=1), device)
+        return _numpy(trained.rgb(both[:, :3], both[:, 3:], chunk_points=chunk_points))
 
     return color
 
@@ -114,12 +117,10 @@ def semantic_mesh_of_field(trained, config: ExtractConfig, device: torch.device,
         chunk_points=config.chunk_points,
         min_component_area_fraction=config.min_component_area_fraction, progress=progress,
     )
-    probabilities = evaluate_in_chunks(
-        field_probability_fn(trained, device, config.chunk_points), vertices_m,
-        config.chunk_points, out_shape=(NUM_CLASSES,)).astype(np.float32)
+    probabilities = field_probability_fn(trained, device, config.chunk_points)(
+        vertices_m).astype(np.float32)
     labels = np.argmax(probabilities, axis=1).astype(np.uint8)
-    rgb = color_vertices(vertices_m, faces, field_color_fn(trained, device, config.chunk_points),
-                         chunk_points=config.chunk_points)
+    rgb = color_vertices(vertices_m, faces, field_color_fn(trained, device, config.chunk_points))
     return SemanticMesh(vertices_m, faces, labels, rgb, probabilities)
 
 
@@ -150,11 +151,21 @@ def measure_field(
     start = time.perf_counter()
     device = device if device is not None else getattr(trained, "device", torch.device("cpu"))
     mesh = semantic_mesh_of_field(trained, config, device, progress=progress)
-    m = measure_semantic_mesh(
-        mesh.vertices_m, mesh.faces, mesh.vertex_labels, config=config.measure,
-        vertex_probabilities=mesh.vertex_probabilities if config.soft_facade_split else None)
-    if config.areas == "planes":
-        m = with_plane_sampled_areas(m, mesh, trained, config, device)
+    return measure_mesh(trained, mesh, config, device=device, start_s=start), mesh
+
+
+def measure_mesh(trained, mesh: SemanticMesh, config: ExtractConfig, *, device: torch.device,
+                 start_s: float | None = None) -> MethodResult:
+    """The result of a field's semantic mesh: the mesh measured
+    (:func:`neural3d.extraction.measure.measure_semantic_mesh`) and the field's footprint.
+
+    ``start_s``: the :func:`time.perf_counter` the result's ``wall_time_s`` counts from
+    (default: now). A footprint that cannot be found becomes ``None`` with a warning.
+    """
+    start = time.perf_counter() if start_s is None else start_s
+    m = measure_semantic_mesh(mesh.vertices_m, mesh.faces, mesh.vertex_labels,
+                              config=config.measure,
+                              vertex_probabilities=mesh.vertex_probabilities)
     warnings: list[str] = []
     if m.wwr is None:
         warnings.append("the mesh has no wall, window or door vertex: WWR undefined")
@@ -164,41 +175,19 @@ def measure_field(
             field_sdf_fn(trained, device, config.chunk_points), trained.box_min_m,
             trained.box_max_m, heights_m=footprint_heights_m(trained.box_max_m, config),
             cell_m=footprint_cell_m(trained.box_min_m, trained.box_max_m, config),
-            min_area_m2=config.footprint_min_area_m2,
-            chunk_points=config.chunk_points,
+            min_area_m2=config.footprint_min_area_m2, roofed_hole_fill=config.roofed_hole_fill,
         )
         footprint = polygon_to_geojson(polygon)
     except ValueError as exc:
         footprint = None
         warnings.append(f"no footprint: {exc}")
-    result = MethodResult(
+    return MethodResult(
         scene=trained.scene_name, method=METHOD, protocol=PROTOCOL, wwr=m.wwr,
         window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
         footprint=footprint, config=asdict(config), code_version=code_version(),
         facade_identity="geometry",
         wall_time_s=time.perf_counter() - start, warnings=tuple(warnings),
     )
-    return result, mesh
-
-
-def with_plane_sampled_areas(m: MeshMeasurement, mesh: SemanticMesh, trained,
-                             config: ExtractConfig, device: torch.device) -> MeshMeasurement:
-    """``m`` with its whole-building areas and WWR read on its facade planes' grids.
-
-    Per-facade figures stay the mesh's. See :mod:`neural3d.extraction.plane_sampling`.
-    """
-    extents = plane_extents(mesh.vertices_m, mesh.faces,
-                            tuple((f.azimuth_deg, f.offset_m) for f in m.facades),
-                            slab_m=config.measure.plane_slab_m,
-                            max_angle_deg=config.measure.plane_max_angle_deg)
-    sdf = field_sdf_fn(trained, device, config.chunk_points)
-    label = field_label_fn(trained, device, config.chunk_points)
-    areas = [plane_sampled_areas(sdf, label, e, cell_m=config.plane_cell_m,
-                                 depth_m=config.plane_depth_m) for e in extents]
-    window, wall, door = (sum(getattr(a, k) for a in areas)
-                          for k in ("window_m2", "wall_m2", "door_m2"))
-    return replace(m, window_area_m2=window, wall_area_m2=wall, door_area_m2=door,
-                   facade_area_m2=wall + window + door, wwr=wwr_from_areas(window, wall, door))
 
 
 def extract_run(
@@ -260,15 +249,12 @@ def _class_ids_of(class_names) -> np.ndarray:
     return ids
 
 
-def _batched(fn, points: np.ndarray, device: torch.device, chunk_points: int, *,
-             grad: bool = False) -> np.ndarray:
-    outs = []
-    for start in range(0, len(points), chunk_points):
-        x = torch.as_tensor(points[start:start + chunk_points], dtype=torch.float32,
-                            device=device)
-        with torch.set_grad_enabled(grad):
-            outs.append(fn(x).detach().float().cpu().numpy())
-    return np.concatenate(outs) if outs else np.zeros((0,))
+def _tensor(points: np.ndarray, device: torch.device) -> torch.Tensor:
+    return torch.as_tensor(points, dtype=torch.float32, device=device)
+
+
+def _numpy(values: torch.Tensor) -> np.ndarray:
+    return values.detach().float().cpu().numpy()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -290,11 +276,15 @@ def main(argv: list[str] | None = None) -> int:
                         help="measure the field as it was at this evaluation step (its "
                              "snapshot in RUN/snapshots/) instead of the final one; output "
                              "to RUN/extract/step_<STEP> unless --out")
+    parser.add_argument("--without", default="", metavar="STAGE[,STAGE]",
+                        help="measure with these stages off (and the stages that need them; "
+                             f"docs/neural3d-extract.md): {', '.join(STAGES)}")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
 
     def body() -> int:
-        config = ExtractConfig(resolution=args.resolution)
+        off = [s.strip() for s in args.without.split(",") if s.strip()]
+        config = without_stages(ExtractConfig(resolution=args.resolution), *off)
         check_mesh_resources(config.resolution)
         if args.out is not None:
             check_output_folder(args.out)

@@ -16,10 +16,11 @@ from pathlib import Path
 from typing import Any, Literal
 
 from dataset.core.method import Method
+from dataset.core.method_input import MethodInput, require_method_input
 from dataset.core.method_options import Option
 from dataset.core.protocols import TRAIN_PROTOCOL
 from dataset.core.results import MethodResult
-from dataset.core.scene_record import Scene, scene_name
+from dataset.core.scene_record import scene_name
 from neural3d.config import TrainConfig, config_to_dict, preset_config
 from neural3d.extraction.extract_config import ExtractConfig
 
@@ -37,7 +38,8 @@ class Neural3dBudget:
     wall-clock safety cap per building (a run it stops is marked cut short);
     ``threads``: torch CPU threads (recorded, since reductions depend on it);
     ``resolution``, ``eval_frames``: marching-cubes resolution and eval frames
-    (``None``: neural3d's / the preset's own); ``device``: cpu or cuda.
+    (``None``: neural3d's / the preset's own); ``device``: cpu or cuda; ``seed``:
+    the training seed (weights, ray batches), so that repeated trainings differ only by it.
     """
 
     preset: Literal["paper", "fast", "tiny"] = "fast"
@@ -47,6 +49,7 @@ class Neural3dBudget:
     resolution: int | None = None
     eval_frames: int | None = None
     device: str = "cpu"
+    seed: int = 0
 
     def __post_init__(self) -> None:
         if self.steps is not None and self.steps < 1:
@@ -87,8 +90,8 @@ def check_budget(budget: Neural3dBudget, runs_here: bool) -> None:
 
 
 def train_config(budget: Neural3dBudget) -> TrainConfig:
-    """The preset's training config with the budget's steps and eval frames."""
-    config = preset_config(budget.preset)
+    """The preset's training config with the budget's steps, eval frames and seed."""
+    config = replace(preset_config(budget.preset), seed=budget.seed)
     if budget.steps is not None:
         config = replace(config, iterations=budget.steps)
     if budget.eval_frames is not None:
@@ -121,7 +124,7 @@ def _budget_record(budget: Neural3dBudget) -> dict[str, Any]:
     }
 
 
-def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
+def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
                  artefacts_dir: Path) -> MethodResult:
     """Train for ``budget.steps`` steps (``neural3d.train``) into ``artefacts_dir / <scene>``,
     then extract (``neural3d.extract``) into its ``extract`` folder.
@@ -134,6 +137,7 @@ def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
     time cap cut training short, and, when training was reused, says so in ``warnings``
     with ``wall_time_s`` = the stored training and evaluation seconds + this extraction.
     """
+    require_method_input(scene, "neural3d")
     import torch
 
     # isort sees a module as first-party only once its file exists: keep this block as is.
@@ -165,7 +169,7 @@ def run_neural3d(scene: Scene, protocol: str, budget: Neural3dBudget, *,
         wall_time_s = trained_s + time.perf_counter() - tic
     return replace(result, config={**result.config, **_budget_record(budget)}, steps=steps,
                    cut_short=steps < config.iterations, wall_time_s=wall_time_s,
-                   warnings=result.warnings + reused)
+                   warnings=result.warnings + reused, seed=budget.seed)
 
 
 def reserve(budget: Neural3dBudget) -> tuple[float, float]:

@@ -29,7 +29,7 @@ from dataset.core.device import resolve_device
 from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from dataset.core.resources import check_training_resources
 from dataset.core.scene_record import scene_name
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input
 from neural3d.config import PRESETS, TrainConfig, preset_config
 from neural3d.field.checkpoint import (
     CHECKPOINT_NAME,
@@ -79,7 +79,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
     """
     device = resolve_device(device)
     scene_dir = Path(scene_dir)
-    scene = read_scene(scene_dir)
+    scene = read_method_input(scene_dir)  # never the truth
     run_dir = Path(out_dir) / scene_name(scene_dir)
     bg = background_class(scene)
     check_training_resources(sum(

@@ -27,7 +27,7 @@ from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
 from dataset.core.mesh import LabelledMesh, concatenate_meshes
 from dataset.core.truth import Building, BuildingTruth, FacadeTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.generate import GenerateConfig, generate_preset
 from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import generate_scene
@@ -94,11 +94,11 @@ def make_box_building() -> Building:
                 for c in (SemanticClass.WINDOW, SemanticClass.DOOR)}
         window, door = area[SemanticClass.WINDOW], area[SemanticClass.DOOR]
         wall = width * height - window - door
-        gross = gross_facade_area_m2(wall, window, door)
+        areas = ClassAreas(window, wall, door)
         facades.append(FacadeTruth(
             id=i + 1, normal=tuple(float(x) for x in normal), width_m=width, height_m=height,
-            window_area_m2=window, wall_area_m2=wall, door_area_m2=door, facade_area_m2=gross,
-            wwr=wwr_from_areas(window, wall, door),
+            window_area_m2=window, wall_area_m2=wall, door_area_m2=door,
+            facade_area_m2=areas.gross_m2, wwr=areas.wwr,
         ))
     x_axis, y_axis = np.array([1.0, 0, 0]), np.array([0, 1.0, 0])
     roof_corner = corners[0] + height * up
@@ -110,12 +110,12 @@ def make_box_building() -> Building:
     window = sum(f.window_area_m2 for f in facades)
     wall = sum(f.wall_area_m2 for f in facades)
     door = sum(f.door_area_m2 for f in facades)
-    gross = gross_facade_area_m2(wall, window, door)
+    areas = ClassAreas(window, wall, door)
     footprint = shapely_box(-sx / 2, -sy / 2, sx / 2, sy / 2)
     truth = BuildingTruth(
         id="box", type="imported", floors=BOX_FLOORS, height_m=height, window_area_m2=window,
-        facade_area_m2=gross, wall_area_m2=wall, door_area_m2=door,
-        wwr=wwr_from_areas(window, wall, door), footprint=polygon_to_geojson(footprint),
+        facade_area_m2=areas.gross_m2, wall_area_m2=wall, door_area_m2=door,
+        wwr=areas.wwr, footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area), facades=tuple(facades), name="test box",
     )
     return Building(mesh=mesh, truth=truth)

@@ -17,7 +17,7 @@ from dataset.core.camera import Intrinsics, look_at
 from dataset.core.scene_record import Frame, Scene
 from dataset.rendering.render import render_view
 from dataset.scenes.images import write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import read_scene, write_transforms
+from dataset.scenes.scene import read_method_input, write_transforms
 
 W, H, DISTANCE_M, EYE_Z_M = 256, 192, 25.0, 4.5
 
@@ -40,7 +40,7 @@ def write_tight_scene(building, root, below_px: float):
                             semantic_file_path=f"semantics/{name}",
                             depth_file_path=f"depth/{name}"))
     write_transforms(root, Scene(root=root, frames=tuple(frames)))
-    return read_scene(root)
+    return read_method_input(root)
 
 
 def test_a_foot_on_the_bottom_border_is_not_a_cut(box_building, tmp_path):

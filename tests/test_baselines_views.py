@@ -9,7 +9,7 @@ from baselines_synthetic import facade_pose, window_grid, write_facade_scene
 from baselines.views import load_views
 from dataset.core.camera import Intrinsics
 from dataset.scenes.images import write_labels
-from dataset.scenes.scene import read_scene, write_transforms
+from dataset.scenes.scene import read_method_input, read_scene, write_transforms
 from dataset.scenes.scene_validation import InvalidSceneError
 
 K = Intrinsics.from_fov(64, 48, 60.0)
@@ -26,7 +26,7 @@ def scene(tmp_path):
     f[3] = replace(f[3], semantic_file_path=None)
     f[5] = replace(f[5], depth_file_path=None)
     write_transforms(s.root, replace(s, frames=tuple(f)))
-    return read_scene(s.root)
+    return read_method_input(s.root)
 
 
 def test_bad_views_are_skipped_with_one_warning_each(scene):

@@ -13,7 +13,7 @@ from dataset.core.camera import Intrinsics
 from dataset.core.classes import SemanticClass
 from dataset.core.results import read_result
 from dataset.core.scene_record import Frame
-from dataset.scenes.scene import read_scene, write_transforms
+from dataset.scenes.scene import read_method_input, write_transforms
 
 L_M, H_M = 12.0, 9.0
 WINDOWS = window_grid(L_M, H_M, 4, 3, 1.6, 1.5)
@@ -65,7 +65,7 @@ def _scene(tmp_path):
     frames = list(s.frames)
     frames[3] = replace(frames[3], semantic_file_path=None)
     write_transforms(s.root, replace(s, frames=tuple(frames)))
-    return read_scene(s.root)
+    return read_method_input(s.root)
 
 
 def test_run_averages_views_then_facades_and_reports_missing(tmp_path):

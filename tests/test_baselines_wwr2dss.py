@@ -26,7 +26,7 @@ from dataset.core.results import read_result
 from dataset.core.scene_record import Frame
 from dataset.rendering.render import render_ground_truth
 from dataset.scenes.images import write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import read_scene, write_transforms
+from dataset.scenes.scene import read_method_input, write_transforms
 
 L_M, H_M = 12.0, 9.0
 WINDOWS = window_grid(L_M, H_M, 4, 3, 1.6, 1.5)
@@ -119,7 +119,7 @@ def _two_facade_scene(tmp_path):
     f2 = Frame("images/b.png", pose2, k, "ideal", facade_id=2, depth_file_path="depth/b.png",
                semantic_file_path="semantics/b.png")
     write_transforms(root, replace(a, frames=(*a.frames, f2)))
-    return read_scene(root), true_wwr(24.0, 6.0, wins2)
+    return read_method_input(root), true_wwr(24.0, 6.0, wins2)
 
 
 def test_alpha_and_area_weighting_of_measured_facades(tmp_path):
@@ -147,7 +147,7 @@ def test_every_bad_view_is_skipped_with_its_reason(tmp_path):
     frames[4] = replace(frames[4], facade_id=None)
     frames[5] = replace(frames[5], depth_file_path=None)
     write_transforms(s.root, replace(s, frames=tuple(frames)))
-    r = run_2dss(read_scene(s.root), "ideal")
+    r = run_2dss(read_method_input(s.root), "ideal")
     reasons = {f.id: f.reason for f in r.facades if f.missing}
     assert set(reasons) == {2, 3, 6} and not r.facades[0].missing
     assert "cut off" in reasons[2]
@@ -160,7 +160,7 @@ def test_every_bad_view_is_skipped_with_its_reason(tmp_path):
     # No depth where the mask shows the facade is a bad scene, not a view to skip.
     write_depth_m(s.root / "depth" / "ideal_003.png", np.zeros((96, 128)), 0.001)
     with pytest.raises(ValueError, match="ideal_003.png: .* building pixels have no valid depth"):
-        run_2dss(read_scene(s.root), "ideal")
+        run_2dss(read_method_input(s.root), "ideal")
 
 
 def test_cli_writes_results_and_debug_images(tmp_path, capsys):

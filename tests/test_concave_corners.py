@@ -5,7 +5,6 @@ inner corner is cut by a chamfer with legs of ``LEG_M``: what a trained field le
 inner corner of an L. The sharp L has 40 m of walls, 240 m² of facade.
 """
 
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -13,11 +12,12 @@ import trimesh
 from shapely.geometry import Polygon
 
 from dataset.core.classes import SemanticClass
-from neural3d.extraction.measure import MeasureConfig, measure_semantic_mesh
+from neural3d.extraction.measure import measure_semantic_mesh
+from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 
 HEIGHT_M, LEG_M = 6.0, 1.2
 WALL, ROOF, OTHER = int(SemanticClass.WALL), int(SemanticClass.ROOF), int(SemanticClass.OTHER)
-NO_CORNERS = replace(MeasureConfig(), corner_max_gap_m=0.0)
+NO_CORNERS = MeasureConfig(stages=MeasureStages(concave_corner_fill=False))
 
 
 def _l_prism(leg_m=LEG_M, *, inner_x_m=4.0, max_edge_m=0.1):
@@ -80,4 +80,4 @@ def test_a_corner_further_than_the_longest_gap_is_not_filled():
 
 def test_config_is_checked():
     with pytest.raises(ValueError, match="corner_max_gap_m"):
-        MeasureConfig(corner_max_gap_m=-1.0)
+        MeasureConfig(corner_max_gap_m=0.0)

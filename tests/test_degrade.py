@@ -25,7 +25,7 @@ from dataset.degrade.poses import perturb_pose, pose_noise
 from dataset.degrade.scene_copy import RECORD_KEY, degrade_scene
 from dataset.degrade.spec import DEGRADATIONS, DegradeSpec, parse_specs, specs_key
 from dataset.scenes.images import read_labels
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input, read_scene
 from dataset.scenes.scene_writer import GenerateConfig, generate_scene
 
 WALL, WINDOW = int(SemanticClass.WALL), int(SemanticClass.WINDOW)
@@ -197,7 +197,7 @@ def test_depth_holes_are_read_and_the_baselines_run_on_them(box_scene: Path,
         depth = read_frame_depth_m(scene, frame, labels)
         holes += int(((labels == WINDOW) & (depth == 0)).sum())
     assert holes > 0
-    assert run_2dss(scene, "ideal").wwr is not None
+    assert run_2dss(read_method_input(out), "ideal").wwr is not None
     frame = scene.frames_in("ideal")[0]
     write_depth_m(out / frame.depth_file_path, np.zeros((48, 48)), 0.001)
     with pytest.raises(InvalidSceneError, match="building pixels have no valid depth"):

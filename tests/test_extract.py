@@ -34,21 +34,25 @@ class AnalyticField:
         self.box_max_m = np.array([4.0, 3.0, 11.0])
         self.device = torch.device("cpu")
         self._labels = banded_labels(self._sdf, (3.0, 6.0))
+        self.chunk_points_asked: set[int] = set()  # what the adapters pass on
 
     @staticmethod
     def _sdf(p):
         return box_sdf(p, BOX_LO, BOX_HI)
 
-    def sdf_m(self, points):
+    def sdf_m(self, points, *, chunk_points):
+        self.chunk_points_asked.add(chunk_points)
         return torch.as_tensor(self._sdf(points.double().numpy()))
 
-    def semantic_logits(self, points):
+    def semantic_logits(self, points, *, chunk_points):
+        self.chunk_points_asked.add(chunk_points)
         ids = self._labels(points.double().numpy())
         logits = np.zeros((len(ids), len(CLASS_NAMES)))
         logits[np.arange(len(ids)), len(CLASS_NAMES) - 1 - ids] = 5.0  # reversed class order
         return torch.as_tensor(logits)
 
-    def rgb(self, points, view_dirs):
+    def rgb(self, points, view_dirs, *, chunk_points):
+        self.chunk_points_asked.add(chunk_points)
         return (view_dirs + 1) / 2
 
 
@@ -80,7 +84,9 @@ CONFIG = ExtractConfig(resolution=96, footprint_cell_m=0.1)
 
 
 def test_measure_field_on_an_analytic_field(scene_dir):
-    result, mesh = measure_field(AnalyticField(scene_dir), CONFIG)
+    field = AnalyticField(scene_dir)
+    result, mesh = measure_field(field, CONFIG)
+    assert field.chunk_points_asked == {CONFIG.chunk_points}  # the field splits, nothing else
     assert (result.method, result.protocol, result.scene) == ("neural3d", "train", "analytic_box")
     assert result.wwr == pytest.approx(0.3, abs=0.01)
     assert result.facade_area_m2 == pytest.approx(200.0, rel=0.02)  # 0.12 m voxels cut edges
@@ -95,7 +101,8 @@ def test_measure_field_on_an_analytic_field(scene_dir):
     footprint = geojson_to_polygon(result.footprint)
     truth = rectangle(-3, -2, 3, 2)
     assert footprint.intersection(truth).area / footprint.union(truth).area >= 0.99
-    assert result.config["resolution"] == 96 and result.config["measure"]["count"] == "projected"
+    assert result.config["resolution"] == 96
+    assert all(result.config["measure"]["stages"].values()) and result.config["roofed_hole_fill"]
     # labels went through the class-name mapping: roof on top, never an unknown id
     assert mesh.vertex_labels[np.argmax(mesh.vertices_m[:, 2])] == 3
     assert mesh.vertex_rgb.dtype == np.uint8 and mesh.vertex_rgb.shape == (len(mesh.vertices_m), 3)
@@ -131,6 +138,8 @@ def test_cli_errors_are_one_line(tmp_path, capsys):
     assert "does not exist" in err and "\n" not in err
     assert main(["--run", str(tmp_path)]) == 2  # a folder that is no run
     assert "config.json is missing" in capsys.readouterr().err
+    assert main(["--run", str(tmp_path), "--without", "corners"]) == 2
+    assert "unknown stage(s) ['corners']" in capsys.readouterr().err
     assert not (tmp_path / "extract").exists()
 
 
@@ -150,24 +159,16 @@ def test_extract_run_on_a_trained_run(box_building, tmp_path):
     config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
     run_dir = train(scene, config, tmp_path / "runs", device=torch.device("cpu"))
     out = tmp_path / "out"
-    assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out)]) == 0
+    assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out),
+                 "--without", "occluded_fill,roofed_hole_fill"]) == 0
     result = read_result(out / result_filename("box", "neural3d", "train"))
     assert (result.method, result.protocol) == ("neural3d", "train")
+    stages = result.config["measure"]["stages"]
+    assert not stages["occluded_fill"] and stages["concave_corner_fill"]
+    assert not result.config["roofed_hole_fill"]
     assert [f.id for f in result.facades] == list(range(1, len(result.facades) + 1))
     assert all(f.normal is not None and f.centre_m is not None for f in result.facades)
     v, f, labels, rgb = read_semantic_ply(out / "mesh.ply")
     assert len(f) > 0 and labels.max() < len(CLASS_NAMES)
     assert (out / "footprint.geojson").is_file() == (result.footprint is not None)
 
-
-
-def test_plane_sampled_areas_on_an_analytic_field(scene_dir):
-    """areas='planes': the band of windows (3 m of 10 on 20 m of walls) read on the planes."""
-    config = replace(CONFIG, areas="planes", plane_cell_m=0.1)
-    result, _ = measure_field(AnalyticField(scene_dir), config)
-    # 0.1 m cells: the band edges (3 m, 6 m) fall on cell edges; the walls' ends lie within
-    # half a marching-cubes voxel (0.06 m) of the extents found on the mesh.
-    assert result.window_area_m2 == pytest.approx(60.0, rel=0.02)
-    assert result.facade_area_m2 == pytest.approx(200.0, rel=0.02)
-    assert result.wwr == pytest.approx(0.3, abs=0.005)
-    assert result.config["areas"] == "planes"

@@ -6,12 +6,12 @@ from sdf_shapes import banded_labels, box_sdf
 
 from dataset.core.classes import FACADE_CLASSES
 from dataset.core.mesh import triangle_normals
+from neural3d.extraction.facade_groups import class_area_m2, group_facade_faces
 from neural3d.extraction.facade_planes import (
     azimuth_offset,
     circular_mean_deg,
     project_onto_facade_planes,
 )
-from neural3d.extraction.measure import class_area_m2, group_facade_faces
 from neural3d.extraction.measure_config import MeasureConfig
 from neural3d.extraction.meshing import extract_mesh, label_vertices
 

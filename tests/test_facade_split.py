@@ -6,9 +6,10 @@ from scipy.special import erf
 from sdf_shapes import box_sdf
 
 from dataset.core.classes import NUM_CLASSES, SemanticClass
+from neural3d.extraction.facade_groups import class_area_m2
 from neural3d.extraction.facade_split import split_facade_area_by_probability
-from neural3d.extraction.measure import class_area_m2, measure_semantic_mesh
-from neural3d.extraction.measure_config import MeasureConfig
+from neural3d.extraction.measure import measure_semantic_mesh
+from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 from neural3d.extraction.meshing import extract_mesh
 
 WALL, WINDOW, ROOF = int(SemanticClass.WALL), int(SemanticClass.WINDOW), int(SemanticClass.ROOF)
@@ -73,7 +74,7 @@ def test_blurred_window_keeps_its_area_where_the_argmax_loses_its_corners():
     p = _probabilities(p_window, roof=roof | (v[:, 2] < 1e-6))
     labels = np.argmax(p, axis=1)
     truth = 4 * 2 * half_w * (z1 - z0)  # 7.2 m²
-    config = MeasureConfig(visibility_rays_per_sample=0, occlusion_cell_m=0.0)  # a plain box
+    config = MeasureConfig(stages=MeasureStages().without("visibility_cull", "plane_probe"))
     hard = measure_semantic_mesh(v, f, labels, config=config)
     soft = measure_semantic_mesh(v, f, labels, config=config, vertex_probabilities=p)
     assert hard.window_area_m2 < 0.97 * truth  # the rounded corners

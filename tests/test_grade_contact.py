@@ -7,9 +7,9 @@ import trimesh
 
 from dataset.core.classes import SemanticClass
 from dataset.core.mesh import LabelledMesh
+from dataset.importers.bodies import orient_bodies
 from dataset.importers.contact import split_touching_faces
-from dataset.importers.grade import edge_balance, split_at_height
-from dataset.importers.mesh_files import merge_vertices
+from dataset.importers.grade import split_at_height
 
 
 def _boxes(*bounds) -> LabelledMesh:
@@ -20,16 +20,6 @@ def _boxes(*bounds) -> LabelledMesh:
                         np.zeros(n, dtype=np.int32))
 
 
-def test_edge_balance_accepts_touching_bodies_and_counts_holes_and_flips():
-    touching = _boxes(((0, 0, 0), (1, 1, 1)), ((1, 0, 0), (2, 1, 1)))  # share a face
-    faces = merge_vertices(touching.vertices_m, touching.faces)[1]
-    assert edge_balance(faces) == (0, 0)
-    assert edge_balance(faces[1:]) == (3, 0)  # one face missing: its three edges are open
-    flipped = faces.copy()
-    flipped[0] = flipped[0, ::-1]
-    assert edge_balance(flipped) == (0, 3)
-
-
 def test_split_at_height_keeps_area_orientation_and_closedness():
     box = _boxes(((0, 0, -1), (2, 3, 2)))
     cut, parent = split_at_height(box, 0.0)
@@ -37,7 +27,8 @@ def test_split_at_height_keeps_area_orientation_and_closedness():
     z = cut.triangles_m[:, :, 2]
     assert ((z.min(axis=1) >= -1e-12) | (z.max(axis=1) <= 1e-12)).all()  # none crosses
     np.testing.assert_allclose(cut.face_normals(), box.face_normals()[parent], atol=1e-12)
-    assert edge_balance(merge_vertices(cut.vertices_m, cut.faces)[1]) == (0, 0)
+    counts = orient_bodies(cut.vertices_m, cut.faces).counts
+    assert (counts["open"], counts["rewound"], counts["turned_inside_out"]) == (0, 0, 0)
     below = z.mean(axis=1) < 0
     assert cut.face_areas_m2()[below].sum() == pytest.approx(2 * 3 + 2 * (2 + 3) * 1.0)
 

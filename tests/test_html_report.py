@@ -15,13 +15,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from metrics.aggregate import Summary
 from metrics.compare import main as compare_main
 from metrics.html_report import REPORT_FILE, main
 from metrics.mesh_decimate import decimate_vertex_clustering
 from metrics.report import TABLE2_NAME, TABLE3_NAME
 from metrics.report_browser import CHROMIUM, open_report
-from metrics.tables import format_cell, read_csv_rows
+from metrics.tables import format_cell, read_csv_rows, read_summary
 
 MAX_REPORT_BYTES = 15_000_000
 
@@ -125,8 +124,7 @@ def test_report_in_headless_chromium(compared, tmp_path):
                 by_key = {(f, m, v): cells for f, m, v, cells in shown}
                 column = 5  # the first figure column of both tables
                 for r in csv_rows:
-                    mean, std = r[f"{key}_mean"], r[f"{key}_std"]
-                    s = Summary(float(mean), float(std), 1) if mean else None
+                    s = read_summary(r, key)
                     cells = by_key[(r["family"], r["method"], r["protocol"])]
                     assert cells[column] == format_cell(s, decimals)
                     assert cells[3] == r["buildings"] and cells[4] == r["failed"]

@@ -6,12 +6,9 @@ import pytest
 from sdf_shapes import banded_labels, box_sdf, cylinder_sdf, l_prism_sdf
 
 from dataset.core.classes import SemanticClass
-from neural3d.extraction.measure import (
-    MeasureConfig,
-    class_area_m2,
-    group_facade_faces,
-    measure_semantic_mesh,
-)
+from neural3d.extraction.facade_groups import class_area_m2, group_facade_faces
+from neural3d.extraction.measure import measure_semantic_mesh
+from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 from neural3d.extraction.meshing import extract_mesh, label_vertices
 
 WALL, WINDOW, ROOF = int(SemanticClass.WALL), int(SemanticClass.WINDOW), int(SemanticClass.ROOF)
@@ -94,15 +91,19 @@ def test_grouping_config_and_ungrouped_area(banded_box):
     roof_only = (labels[f] == ROOF).all(axis=1)
     assert (group[roof_only] == -1).all()
     strict = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
-        count="all", min_facade_area_m2=50.0))
+        stages=MeasureStages().without("plane_projection"), min_facade_area_m2=50.0))
     assert len(strict.facades) == 2  # only the 6 m wide (60 m²) facades stay
     assert strict.ungrouped_facade_area_m2 == pytest.approx(80, rel=0.02)
-    grouped = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
-        count="grouped", min_facade_area_m2=50.0))
-    assert grouped.facade_area_m2 == pytest.approx(sum(fa.facade_area_m2 for fa in strict.facades))
+    # without planes every triangle counts: the groups only give the per-facade figures
+    assert strict.facade_area_m2 == pytest.approx(
+        sum(fa.facade_area_m2 for fa in strict.facades) + strict.ungrouped_facade_area_m2)
+    ungrouped = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
+        stages=MeasureStages().without("grouping")))
+    assert ungrouped.facades == () and ungrouped.facade_area_m2 == strict.facade_area_m2
+    assert ungrouped.ungrouped_facade_area_m2 == pytest.approx(ungrouped.facade_area_m2, rel=1e-12)
 
 
-def _recessed_box():
+def _recessed_box(voxel_size_m: float = 0.05):
     """6 x 4 x 10 m box with two 1 x 1.2 m windows per side recessed 0.3 m, and an underside.
 
     Labels: window on the pane and the reveals, roof on top, wall elsewhere, the
@@ -132,7 +133,7 @@ def _recessed_box():
         out[p[:, 2] > 10.0 - 0.01] = ROOF
         return out
 
-    v, f = extract_mesh(sdf, [-4, -3, -1], [4, 3, 11], voxel_size_m=0.05)
+    v, f = extract_mesh(sdf, [-4, -3, -1], [4, 3, 11], voxel_size_m=voxel_size_m)
     return v, f, label_vertices(v, label)
 
 
@@ -148,7 +149,7 @@ def test_projected_counts_recesses_and_underside_once():
         assert facade.window_area_m2 == pytest.approx(2.4, abs=0.25)
     # counting every triangle adds the reveals (8 x 4.4 m x 0.3 m) and the 24 m² underside
     every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
-        count="all", visibility_rays_per_sample=0))
+        stages=MeasureStages().without("plane_projection", "visibility_cull")))
     assert every.window_area_m2 > m.window_area_m2 + 0.8 * 8 * 4.4 * 0.3
     assert every.facade_area_m2 > m.facade_area_m2 + 0.9 * 24.0
 
@@ -164,7 +165,8 @@ def test_surfaces_inside_the_building_count_for_nothing():
     assert seen.facade_area_m2 == pytest.approx(200.0, rel=0.01)
     assert seen.wwr == pytest.approx(0.3, abs=0.01)
     assert seen.ungrouped_facade_area_m2 < 1.0
-    every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(visibility_rays_per_sample=0))
+    every = measure_semantic_mesh(v, f, labels, config=MeasureConfig(
+        stages=MeasureStages(visibility_cull=False)))
     assert every.facade_area_m2 > seen.facade_area_m2 + 0.9 * 72.0
 
 
@@ -186,9 +188,9 @@ def test_bad_inputs(labels, faces, message):
 
 
 @pytest.mark.parametrize("kwargs", [
-    {"count": "some"}, {"facade_max_tilt_deg": 90.0}, {"azimuth_bin_deg": 0.0},
+    {"facade_max_tilt_deg": 90.0}, {"azimuth_bin_deg": 0.0},
     {"min_facade_separation_deg": 0.0}, {"plane_gap_m": -1.0}, {"plane_slab_m": -0.1},
-    {"plane_max_angle_deg": 90.0}, {"curve_strip_m": 0.0}, {"visibility_rays_per_sample": -1},
+    {"plane_max_angle_deg": 90.0}, {"curve_strip_m": 0.0}, {"visibility_rays_per_sample": 0},
     {"min_escape_fraction": 0.0},
 ])
 def test_bad_config(kwargs):

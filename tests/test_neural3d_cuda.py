@@ -13,7 +13,7 @@ from neural3d_scene import write_ring_scene
 from test_neural3d_train import SHORT, SURFACE_TOL_M, box_surface_points
 
 from dataset.core.footprint import geojson_to_polygon
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input, read_scene
 from neural3d.config import preset_config
 from neural3d.extract import ExtractConfig, extract_run
 from neural3d.field.trained import build_field, load_trained_field
@@ -157,7 +157,7 @@ def test_train_cli_on_cuda(scene, tmp_path):
 def test_neural3d_method_on_cuda_reuses_its_training(scene, tmp_path):
     """A comparison's neural3d on CUDA: trained once, then only re-extracted."""
     budget = Neural3dBudget(preset="tiny", steps=30, resolution=32, device="cuda")
-    read = read_scene(scene)
+    read = read_method_input(scene)
     first = run_neural3d(read, "train", budget, artefacts_dir=tmp_path)
     again = run_neural3d(read, "train", budget, artefacts_dir=tmp_path)
     assert first.steps == again.steps == 30

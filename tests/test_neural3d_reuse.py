@@ -11,7 +11,7 @@ import torch
 from neural3d_scene import write_ring_scene
 
 from dataset.core.scene_record import scene_name
-from dataset.scenes.scene import read_scene
+from dataset.scenes.scene import read_method_input
 from neural3d.config import config_to_dict, preset_config
 from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
 from neural3d.method import Neural3dBudget, run_neural3d, train_config
@@ -56,7 +56,7 @@ def test_prior_run_tells_finished_partial_and_other(scene, tmp_path):
 
 
 def test_second_run_reuses_the_training_and_measures_the_same(scene, tmp_path):
-    read = read_scene(scene)
+    read = read_method_input(scene)
     first = run_neural3d(read, "train", BUDGET, artefacts_dir=tmp_path)
     checkpoint = tmp_path / scene_name(scene) / CHECKPOINT_NAME
     written = checkpoint.stat().st_mtime_ns
@@ -83,7 +83,7 @@ def test_a_partial_run_is_resumed_to_the_budget(scene, tmp_path):
     run_json["provenance"] = training_provenance(scene, full, CPU).to_json_dict()
     (run / "run.json").write_text(json.dumps(run_json))
     (run / "config.json").write_text(json.dumps(config_to_dict(full)))
-    result = run_neural3d(read_scene(scene), "train", BUDGET, artefacts_dir=tmp_path)
+    result = run_neural3d(read_method_input(scene), "train", BUDGET, artefacts_dir=tmp_path)
     assert result.steps == STEPS and not result.cut_short
     assert not any("training reused" in w for w in result.warnings)
     assert int(read_checkpoint(run / CHECKPOINT_NAME, CPU)["step"]) == STEPS

@@ -40,3 +40,24 @@ def test_bad_inputs(field, tmp_path):
         field.rgb(torch.zeros(2, 3), torch.zeros(3, 3))
     with pytest.raises(ValueError, match="not a neural3d run folder"):
         load_trained_field(tmp_path, device=CPU)
+
+
+def test_queries_split_into_calls_of_chunk_points(field):
+    """The one place a field is evaluated in chunks: each network call takes at most
+    ``chunk_points`` points, and the answers do not depend on the split."""
+    p = torch.rand(10, 3) * 8.0
+    whole_sdf, whole_logits = field.sdf_m(p), field.semantic_logits(p)
+    whole_rgb = field.rgb(p, -p)
+    sizes = []
+    hook = field.field.sdf_net.register_forward_pre_hook(lambda _, args: sizes.append(
+        len(args[0])))
+    try:
+        split = (field.sdf_m(p, chunk_points=4), field.semantic_logits(p, chunk_points=3),
+                 field.rgb(p, -p, chunk_points=6))
+    finally:
+        hook.remove()
+    assert sizes == [4, 4, 2, 3, 3, 3, 1, 6, 4]
+    for got, want in zip(split, (whole_sdf, whole_logits, whole_rgb)):
+        torch.testing.assert_close(got, want, rtol=1e-6, atol=1e-6)
+    with pytest.raises(ValueError, match="chunk_points"):
+        field.sdf_m(p, chunk_points=0)

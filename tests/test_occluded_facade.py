@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from dataset.core.classes import SemanticClass
-from neural3d.extraction.measure import MeasureConfig, measure_semantic_mesh
+from neural3d.extraction.measure import measure_semantic_mesh
+from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 
 WALL, WINDOW, OTHER = int(SemanticClass.WALL), int(SemanticClass.WINDOW), int(SemanticClass.OTHER)
 WIDTH_M, DEPTH_M, HEIGHT_M = 10.0, 8.0, 6.0
@@ -57,7 +58,7 @@ def _building(*, hole_z_m=HOLE_Z_M, balcony=True):
     return np.concatenate(vertices), np.concatenate(faces), np.concatenate(labels)
 
 
-OFF = replace(MeasureConfig(), occlusion_cell_m=0.0)
+OFF = MeasureConfig(stages=MeasureStages().without("plane_probe"))
 
 
 def _front(measurement):
@@ -98,15 +99,15 @@ def test_front_seen_faces_are_the_facade_a_camera_in_front_meets_first():
     other), the roof and the faces of the other walls' planes (seen by their own probes
     only) are told apart by class and plane."""
     from dataset.rendering.raycast import Raycaster
+    from neural3d.extraction.facade_groups import class_area_m2, group_faces
     from neural3d.extraction.facade_planes import project_onto_facade_planes
-    from neural3d.extraction.measure import _group_faces, class_area_m2
     from neural3d.extraction.occluded_facade import front_seen_faces, probe_planes
 
     v, f, lab = _building()
     config = MeasureConfig()
     shares = class_area_m2(v, f, lab)
     facade = shares[:, [WALL, WINDOW, int(SemanticClass.DOOR)]].sum(axis=1)
-    planes = project_onto_facade_planes(v, f, facade, _group_faces(v, f, facade, config),
+    planes = project_onto_facade_planes(v, f, facade, group_faces(v, f, facade, config),
                                         config=config)
     probes = probe_planes(Raycaster.from_triangles(v, f), shares, planes, cell_m=0.1,
                           slab_m=config.plane_slab_m, max_angle_deg=config.plane_max_angle_deg)
@@ -127,6 +128,7 @@ def test_faces_the_hemisphere_test_drops_but_the_front_sees_count():
     v, f, lab = _recessed_box()
     dropped = measure_semantic_mesh(v, f, lab, config=OFF)
     counted = measure_semantic_mesh(v, f, lab)
-    every = measure_semantic_mesh(v, f, lab, config=replace(OFF, visibility_rays_per_sample=0))
+    every = measure_semantic_mesh(v, f, lab, config=replace(
+        OFF, stages=OFF.stages.without("visibility_cull")))
     assert dropped.window_area_m2 < counted.window_area_m2 <= every.window_area_m2 + 1e-9
     assert abs(counted.window_area_m2 - 9.6) < abs(dropped.window_area_m2 - 9.6)

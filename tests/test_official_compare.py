@@ -1,5 +1,7 @@
-"""metrics.compare --data on scenes imported from both official layouts: 2D-S, 2D-SS and
-neural3d (tiny budget: the run, not its accuracy, is checked here) all finish."""
+"""metrics.compare --data on scenes imported from both official layouts (the Blender
+generator's own output, tests/fixtures/buildnet3d_generator; the BlenderProc layout written
+by test_blenderproc's writer): 2D-S, 2D-SS and neural3d (tiny budget: the run, not its
+accuracy, is checked here) all finish."""
 
 from __future__ import annotations
 
@@ -7,7 +9,7 @@ import contextlib
 import io
 
 from test_blenderproc import write_blenderproc_output
-from test_buildnet3d import write_generator_output
+from test_buildnet3d import FIXTURE
 
 from dataset.generate import main as generate_main
 
@@ -16,12 +18,11 @@ def test_metrics_compare_runs_every_method_on_imported_scenes(box_building, tmp_
     from metrics.compare import main as compare_main
     from metrics.report import read_building_errors_csv
 
-    write_generator_output(tmp_path / "blender", box_building)
     write_blenderproc_output(tmp_path / "bproc" / "house", box_building, "generator")
     data = tmp_path / "scenes"
     with contextlib.redirect_stdout(io.StringIO()):
-        for src in ("blender", "bproc"):
-            assert generate_main(["--buildnet3d", str(tmp_path / src), "--out", str(data)]) == 0
+        for src in (FIXTURE / "images/building0", tmp_path / "bproc"):
+            assert generate_main(["--buildnet3d", str(src), "--out", str(data)]) == 0
     argv = ["--data", str(data), "--methods", "2D-S,2D-SS,neural3d", "--views", "ideal",
             "--neural3d-preset", "tiny", "--neural3d-steps", "30",
             "--neural3d-resolution", "32", "--neural3d-threads", "2",

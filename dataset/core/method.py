@@ -8,6 +8,13 @@ registered in :data:`BUILT_IN` as a plugin is under its entry point; ``metrics``
 runs every method through this record (``metrics.methods``) and knows no method
 by name.
 
+The truth is out of a method's reach: ``scene`` is a
+:class:`~dataset.core.method_input.MethodInput` (images, poses, intrinsics, and the depth
+and semantic images the method declares in ``inputs``), never the
+:class:`~dataset.core.scene_record.Scene` with its ``building.json``; metrics reads the
+truth itself. A method's results must not change when ``building.json``, ``mesh.ply`` or
+the facade-id images are removed (``tests/test_truth_blind.py`` checks the built-in ones).
+
 Another package adds a method without touching this repository by exposing a
 :class:`Method` (or a zero-argument callable returning one) under the entry
 point group ``envelope_bench.methods``, e.g. in its ``pyproject.toml``::
@@ -27,6 +34,7 @@ from dataclasses import asdict, dataclass, field
 from importlib.metadata import entry_points
 from typing import Any, Literal
 
+from dataset.core.method_input import Input
 from dataset.core.method_options import Option, field_type
 from dataset.core.protocols import Protocol
 from dataset.core.results import MethodResult
@@ -39,19 +47,21 @@ BUILT_IN: dict[str, str] = {
     "2D-SS": "baselines.methods:METHOD_2DSS",
     "neural3d": "neural3d.method:METHOD_NEURAL3D",
 }
-Input = Literal["rgb", "semantics", "depth", "poses"]
 Resource = Literal["cpu", "gpu"]
 RunMethod = Callable[..., MethodResult]
-"""``run(scene, protocol, config) -> MethodResult`` for one scene; may raise. A method with an
-``artefacts`` folder is called ``run(scene, protocol, config, artefacts_dir=FOLDER)`` and writes
-its folder for the scene (named by the scene) into ``FOLDER``."""
+"""``run(scene, protocol, config) -> MethodResult`` for one scene, ``scene`` a
+:class:`~dataset.core.method_input.MethodInput`; may raise. A method with an ``artefacts``
+folder is called ``run(scene, protocol, config, artefacts_dir=FOLDER)`` and writes its folder
+for the scene (named by the scene) into ``FOLDER``."""
 
 
 @dataclass(frozen=True)
 class Method:
     """A benchmark method.
 
-    ``inputs``: what it reads from a scene (never the truth). ``protocols``:
+    ``inputs``: what it reads from a scene (never the truth): its
+    :class:`~dataset.core.method_input.MethodInput` holds the depth and semantic images
+    only if they are declared here. ``protocols``:
     the view protocols it runs on (``dataset.core.protocols``). ``resources``:
     ``"gpu"`` if it needs one. ``config_type``: a frozen dataclass whose default
     instance is the config it runs with (its fields go into the result's

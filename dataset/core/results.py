@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from dataset.core.atomic import write_json_atomic
+from dataset.core.orientation import OrientationBin, orientation_bin
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.core.provenance import Provenance, code_version
 
@@ -33,6 +34,9 @@ class FacadeEstimate:
     the facade's surface) are in the world frame, for methods whose ids are
     their own (neural3d): evaluation matches such facades to the truth's by
     them (:mod:`metrics.facade_match`). ``None`` where the method does not say.
+    ``azimuth_deg`` is the facade's outward azimuth, degrees clockwise from true
+    north (:mod:`dataset.core.orientation`); methods leave it ``None`` (they do not
+    know north) and evaluation fills it (:mod:`metrics.export_table`).
     """
 
     id: int
@@ -46,6 +50,12 @@ class FacadeEstimate:
     reason: str = ""
     normal: tuple[float, float, float] | None = None
     centre_m: tuple[float, float, float] | None = None
+    azimuth_deg: float | None = None
+
+    @property
+    def orientation(self) -> OrientationBin | None:
+        """EnergyPlus bin (N, E, S, W) of ``azimuth_deg``; ``None`` without one."""
+        return None if self.azimuth_deg is None else orientation_bin(self.azimuth_deg)
 
     @staticmethod
     def from_json_dict(d: dict[str, Any]) -> FacadeEstimate:
@@ -69,6 +79,9 @@ class MethodResult:
     steps an iterative method took (``None`` for the others); ``cut_short``
     says a safety time cap stopped it before its step budget.
     ``facade_identity`` says how its facades are matched to the truth's.
+    ``seed``: the seed of a method trained from random weights (neural3d), so that
+    runs with several seeds keep one file each (:func:`result_filename`); ``None``
+    for a method without one.
     """
 
     scene: str
@@ -87,6 +100,7 @@ class MethodResult:
     cut_short: bool = False
     provenance: Provenance | None = None
     facade_identity: FacadeIdentity = "truth_id"
+    seed: int | None = None
     schema_version: int = RESULT_SCHEMA_VERSION
 
     def __post_init__(self) -> None:
@@ -114,14 +128,17 @@ class MethodResult:
         )
 
 
-def result_filename(scene: str, method: str, protocol: str) -> str:
-    """File name of a result, e.g. ``tiny_skyscraper_0__2D-SS__ideal.json``."""
-    return f"{scene}__{method}__{protocol}.json"
+def result_filename(scene: str, method: str, protocol: str, seed: int | None = None) -> str:
+    """File name of a result, e.g. ``tiny_skyscraper_0__2D-SS__ideal.json``; a seed other than
+    0 (the default one, whose files keep the plain name) adds ``__seed<k>``."""
+    suffix = f"__seed{seed}" if seed else ""
+    return f"{scene}__{method}__{protocol}{suffix}.json"
 
 
 def write_result(folder: str | Path, result: MethodResult) -> Path:
     """Write ``result`` atomically into ``folder``; returns the file path."""
-    path = Path(folder) / result_filename(result.scene, result.method, result.protocol)
+    path = Path(folder) / result_filename(result.scene, result.method, result.protocol,
+                                          result.seed)
     write_json_atomic(path, result.to_json_dict())
     return path
 

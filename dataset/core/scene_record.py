@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -63,7 +63,14 @@ class Scene:
         return self.root / relative
 
 
-def scene_name(scene: Scene | str | Path) -> str:
+class InFolder(Protocol):
+    """Anything read from a scene folder: a :class:`Scene`, a method's
+    :class:`~dataset.core.method_input.MethodInput`."""
+
+    root: Path
+
+
+def scene_name(scene: InFolder | str | Path) -> str:
     """A scene's name in result files, run folders and warnings: its folder's name."""
-    root = scene.root if isinstance(scene, Scene) else Path(scene)
+    root = Path(scene) if isinstance(scene, (str, Path)) else scene.root
     return root.resolve().name

@@ -3,21 +3,36 @@
 Areas follow one convention everywhere: a window's (or door's) area is its
 opening in the facade plane; the reveal (the shallow recess around it) is not
 facade area. Gross facade area = wall + window + door; WWR comes from
-:func:`dataset.core.wwr.wwr_from_areas`, the project's one definition.
+:class:`dataset.core.wwr.ClassAreas`, the project's one definition.
 """
 
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
+from dataset.core.appearance import SurfaceAppearance
 from dataset.core.atomic import write_json_atomic
 from dataset.core.mesh import LabelledMesh
+from dataset.core.neighbours import Neighbour
+from dataset.core.orientation import (
+    NORTH_SOURCES,
+    NorthSource,
+    OrientationBin,
+    azimuth_deg_from_normal,
+    orientation_bin,
+)
+from dataset.core.wwr import ClassAreas
 
-BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported"]
-BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported")
+BuildingType = Literal["skyscraper", "l_shaped", "realistic", "imported", "with_balconies",
+                       "terraced", "detached"]
+BUILDING_TYPES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "imported",
+                                   "with_balconies", "terraced", "detached")
+"""The procedural families, ``imported`` (a mesh or IFC model), and the types CityGML
+buildings get from their geometry (:mod:`dataset.importers.citygml_type`)."""
+_DERIVED_FACADE_KEYS = ("azimuth_deg", "orientation")
 
 
 @dataclass(frozen=True)
@@ -26,7 +41,13 @@ class FacadeTruth:
 
     ``normal`` is the outward unit vector in the world frame (for a curved
     facade, the mean outward direction); ``width_m`` is measured along the wall
-    (arc length for a curved one).
+    (arc length for a curved one). ``azimuth_deg`` (clockwise from true north,
+    :mod:`dataset.core.orientation`) is derived from ``normal`` and the building's
+    ``north_deg`` when the :class:`BuildingTruth` is made (``None``: a vertical normal).
+    ``visible_*_area_m2``: the part seen straight on
+    from the front, not hidden by a railing, a balcony or an overhang
+    (:mod:`dataset.families.visible_facade`); ``None`` where not computed (older files,
+    imported meshes).
     """
 
     id: int
@@ -39,6 +60,15 @@ class FacadeTruth:
     facade_area_m2: float
     wwr: float
     curved: bool = False
+    visible_window_area_m2: float | None = None
+    visible_wall_area_m2: float | None = None
+    visible_door_area_m2: float | None = None
+    azimuth_deg: float | None = None
+
+    @property
+    def orientation(self) -> OrientationBin | None:
+        """EnergyPlus bin (N, E, S, W) of ``azimuth_deg``; ``None`` without one."""
+        return None if self.azimuth_deg is None else orientation_bin(self.azimuth_deg)
 
 
 @dataclass(frozen=True)
@@ -51,6 +81,10 @@ class BuildingTruth:
     unknown (e.g. imported meshes). Evaluation matches a method's own facades
     to the truth's by them. Older files kept them in ``extra["facade_outlines_m"]``:
     they are moved here when read (and when built that way).
+
+    ``north_deg``: clockwise angle from true north to world +y (EnergyPlus North
+    Axis), stated by the source (``north_source``); procedural scenes keep the
+    convention 0 (+y is north). Each facade's ``azimuth_deg`` is derived from it.
     """
 
     id: str
@@ -70,6 +104,8 @@ class BuildingTruth:
     extra: dict[str, Any] = field(default_factory=dict)
     facade_outlines_m: dict[int, tuple[tuple[tuple[float, float, float], ...], ...]] = field(
         default_factory=dict)
+    north_deg: float = 0.0
+    north_source: NorthSource = "convention"
 
     def __post_init__(self) -> None:
         outlines = self.facade_outlines_m
@@ -82,6 +118,23 @@ class BuildingTruth:
                             for outline in walls)
             for fid, walls in outlines.items()
         })
+        if self.north_source not in NORTH_SOURCES:
+            raise ValueError(f"north_source must be one of {NORTH_SOURCES}, "
+                             f"got {self.north_source!r}")
+        object.__setattr__(self, "north_deg", float(self.north_deg))
+        object.__setattr__(self, "facades", tuple(
+            replace(f, azimuth_deg=azimuth_deg_from_normal(f.normal, self.north_deg))
+            for f in self.facades))
+
+    def visible_areas_m2(self) -> ClassAreas | None:
+        """Window, wall and door areas seen straight on, summed over facades; ``None``
+        unless every facade has them."""
+        parts = [(f.visible_window_area_m2, f.visible_wall_area_m2, f.visible_door_area_m2)
+                 for f in self.facades]
+        if not parts or any(x is None for p in parts for x in p):
+            return None
+        window, wall, door = (float(sum(p[k] for p in parts)) for k in range(3))
+        return ClassAreas(window_m2=window, wall_m2=wall, door_m2=door)
 
     def facade(self, facade_id: int) -> FacadeTruth:
         """The facade with id ``facade_id``."""
@@ -93,8 +146,9 @@ class BuildingTruth:
     def to_json_dict(self) -> dict[str, Any]:
         d = asdict(self)
         d["facades"] = [asdict(f) for f in self.facades]
-        for f in d["facades"]:
+        for f, facade in zip(d["facades"], self.facades):
             f["normal"] = list(f["normal"])
+            f["orientation"] = facade.orientation
         d["facade_outlines_m"] = {
             str(fid): [[list(corner) for corner in outline] for outline in walls]
             for fid, walls in sorted(self.facade_outlines_m.items())
@@ -103,8 +157,10 @@ class BuildingTruth:
 
     @staticmethod
     def from_json_dict(d: dict[str, Any]) -> BuildingTruth:
+        # azimuth and orientation are derived from the normal and north_deg, never read
         facades = tuple(
-            FacadeTruth(**{**f, "normal": tuple(float(x) for x in f["normal"])})
+            FacadeTruth(**{**{k: v for k, v in f.items() if k not in _DERIVED_FACADE_KEYS},
+                           "normal": tuple(float(x) for x in f["normal"])})
             for f in d["facades"]
         )
         return BuildingTruth(**{**d, "facades": facades})
@@ -112,10 +168,23 @@ class BuildingTruth:
 
 @dataclass(frozen=True)
 class Building:
-    """A building as the generator (or the importer) makes it: labelled mesh + exact truth."""
+    """A building as the generator (or the importer) makes it: labelled mesh + exact truth.
+
+    Where the source knows them: ``appearance``, the mesh faces' textures and colours
+    (:mod:`dataset.core.appearance`), and ``context``, the buildings around it
+    (:mod:`dataset.core.neighbours`); neither changes the truth.
+    """
 
     mesh: LabelledMesh
     truth: BuildingTruth
+    appearance: SurfaceAppearance | None = None
+    context: tuple[Neighbour, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.appearance is not None and len(self.appearance.face_material) != len(
+                self.mesh.faces):
+            raise ValueError("a building's appearance needs one entry per face of its mesh")
+        object.__setattr__(self, "context", tuple(self.context))
 
 
 def write_building(path: str | Path, truth: BuildingTruth) -> None:

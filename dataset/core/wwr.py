@@ -1,32 +1,59 @@
 """The one definition of the window-to-wall ratio (DESIGN.md), in the core every package imports.
 
 WWR = window area / gross facade area, gross facade = wall + window + door.
-Ground truth, 2D-S and 2D-SS (pixel counts are areas in pixel units), neural3d
-and the metrics all compute it through :func:`wwr_from_areas`; nothing else
-divides a window area by a facade area.
+Areas in m² come in as one value, :class:`ClassAreas` (``.gross_m2``, ``.wwr``):
+ground truth, importers and neural3d build one and read both figures from it.
+:func:`wwr_from_areas` is the same ratio on arrays of class counts in any one
+unit (the 2D methods' pixel counts); :attr:`ClassAreas.wwr` calls it, and
+nothing else divides a window area by a facade area.
 """
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 
 
-def gross_facade_area_m2(wall_area_m2: float, window_area_m2: float, door_area_m2: float) -> float:
-    """Gross facade area in m²: opaque wall + window + door.
+@dataclass(frozen=True)
+class ClassAreas:
+    """Window, opaque wall and door areas of one facade or one building, m² (each >= 0).
 
     Raises
     ------
     ValueError
-        If an area is negative.
+        If an area is negative or not finite.
     """
-    for name, value in (("wall", wall_area_m2), ("window", window_area_m2), ("door", door_area_m2)):
-        if value < 0:
-            raise ValueError(f"{name} area must be >= 0 m², got {value}")
-    return float(wall_area_m2) + float(window_area_m2) + float(door_area_m2)
+
+    window_m2: float
+    wall_m2: float
+    door_m2: float
+
+    def __post_init__(self) -> None:
+        for name in ("window_m2", "wall_m2", "door_m2"):
+            value = float(getattr(self, name))
+            if not math.isfinite(value) or value < 0:
+                raise ValueError(f"{name.removesuffix('_m2')} area must be finite and >= 0 m², "
+                                 f"got {getattr(self, name)}")
+            object.__setattr__(self, name, value)
+
+    @property
+    def gross_m2(self) -> float:
+        """Gross facade area in m²: opaque wall + window + door."""
+        return self.wall_m2 + self.window_m2 + self.door_m2
+
+    @property
+    def wwr(self) -> float | None:
+        """window / gross in [0, 1]; None without facade (all three areas 0)."""
+        return wwr_from_areas(self.window_m2, self.wall_m2, self.door_m2)
 
 
 def wwr_from_areas(window_area, wall_area, door_area):
     """WWR = window / (wall + window + door) of class areas, in [0, 1].
+
+    For areas in m² build a :class:`ClassAreas`; this form takes arrays and
+    other units.
 
     Parameters
     ----------

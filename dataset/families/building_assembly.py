@@ -2,23 +2,31 @@
 
 Per-facade truth is summed from each wall's parameters (outline area, opening
 sizes, contact rectangles), never from the triangulated mesh, so that tests can
-hold one against the other.
+hold one against the other. Only the part of each facade that other surfaces
+hide from the front (:mod:`dataset.families.visible_facade`) needs the mesh: the
+visible areas are the analytic ones less that.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 from shapely.geometry import Polygon
 
+from dataset.core.classes import SemanticClass
 from dataset.core.footprint import polygon_to_geojson
-from dataset.core.mesh import MERGE_DECIMALS
+from dataset.core.mesh import MERGE_DECIMALS, LabelledMesh
 from dataset.core.truth import Building, BuildingTruth, BuildingType, FacadeTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.families.facade_geometry import WallSpec, wall_faces
 from dataset.families.polygon_mesh import PlanarFace, triangulate_faces
+from dataset.families.visible_facade import hidden_facade_areas_m2
+
+HIDDEN_NOISE_M2 = 1e-6
+"""A hidden area below this (1 cm x 0.1 mm) is round-off of the polygon operations, not a
+surface in front of the facade: the visible area is then the full one exactly."""
 
 
 @dataclass(frozen=True)
@@ -43,8 +51,9 @@ def facade_truths(
 ) -> tuple[FacadeTruth, ...]:
     """Truth of every facade (walls grouped by facade id, sorted by id).
 
-    Width is the summed wall length (the length along the facets of a curved facade),
-    height the highest wall point, normal the length-weighted mean outward normal.
+    Width is the summed wall length along the facets of a curved facade, and for a planar
+    facade the length of the union of its walls' spans along it (a recess's back wall
+    adds none); height the highest wall point, normal the length-weighted mean outward normal.
     """
     ids = sorted({w.facade_id for w in walls})
     if ids != list(range(1, len(ids) + 1)):
@@ -55,24 +64,38 @@ def facade_truths(
         window = sum(w.opening_area_m2("window") for w in group)
         door = sum(w.opening_area_m2("door") for w in group)
         wall = sum(w.wall_area_m2() for w in group)
-        gross = gross_facade_area_m2(wall, window, door)
+        areas = ClassAreas(window, wall, door)
         normal = sum(w.frame.length_m * w.frame.normal for w in group)
         normal = normal / np.linalg.norm(normal)
         out.append(
             FacadeTruth(
                 id=fid,
                 normal=tuple(round(float(x), 12) + 0.0 for x in normal),
-                width_m=float(sum(w.frame.length_m for w in group)),
+                width_m=_width_m(group),
                 height_m=max(w.height_m for w in group),
                 window_area_m2=float(window),
                 wall_area_m2=float(wall),
                 door_area_m2=float(door),
-                facade_area_m2=gross,
-                wwr=wwr_from_areas(window, wall, door),
+                facade_area_m2=areas.gross_m2,
+                wwr=areas.wwr,
                 curved=fid in curved_facade_ids,
             )
         )
     return tuple(out)
+
+
+def _width_m(group: list[WallSpec]) -> float:
+    """Summed wall length (curved facade) or the union of parallel walls' spans along them."""
+    axis = group[0].frame.u_axis
+    if len(group) == 1 or any(not np.allclose(w.frame.u_axis, axis, atol=1e-9) for w in group):
+        return float(sum(w.frame.length_m for w in group))
+    spans = sorted(sorted((float(np.dot([*w.frame.p0_xy, 0.0], axis)),
+                           float(np.dot([*w.frame.p1_xy, 0.0], axis)))) for w in group)
+    total, reach = 0.0, -np.inf
+    for lo, hi in spans:
+        total += max(0.0, hi - max(lo, reach))
+        reach = max(reach, hi)
+    return total
 
 
 def facade_outlines_m(walls: list[WallSpec]) -> dict[str, list[list[list[float]]]]:
@@ -108,11 +131,13 @@ def assemble_building(
     """
     if floors < 1:
         raise ValueError(f"a building needs floors >= 1, got {floors}")
-    facades = facade_truths(walls, curved_facade_ids)
+    faces = [face for w in walls for face in wall_faces(w)] + list(other_faces)
+    mesh = triangulate_faces(faces)
+    facades = with_visible_areas(facade_truths(walls, curved_facade_ids), mesh)
     window = sum(f.window_area_m2 for f in facades)
     door = sum(f.door_area_m2 for f in facades)
     wall = sum(f.wall_area_m2 for f in facades)
-    gross = gross_facade_area_m2(wall, window, door)
+    areas = ClassAreas(window, wall, door)
     footprint = Polygon(footprint_xy)
     truth = BuildingTruth(
         id=building_id,
@@ -120,10 +145,10 @@ def assemble_building(
         floors=int(floors),
         height_m=float(height_m),
         window_area_m2=float(window),
-        facade_area_m2=gross,
+        facade_area_m2=areas.gross_m2,
         wall_area_m2=float(wall),
         door_area_m2=float(door),
-        wwr=wwr_from_areas(window, wall, door),
+        wwr=areas.wwr,
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,
@@ -132,8 +157,30 @@ def assemble_building(
         extra=dict(extra or {}),
         facade_outlines_m=facade_outlines_m(walls),
     )
-    faces = [face for w in walls for face in wall_faces(w)] + list(other_faces)
-    return Building(mesh=triangulate_faces(faces), truth=truth)
+    return Building(mesh=mesh, truth=truth)
+
+
+def with_visible_areas(facades: tuple[FacadeTruth, ...],
+                       mesh: LabelledMesh) -> tuple[FacadeTruth, ...]:
+    """``facades`` with their areas seen straight on: the full ones less what other surfaces
+    of ``mesh`` hide from the front (:mod:`dataset.families.visible_facade`).
+    """
+    hidden = hidden_facade_areas_m2(mesh)
+    out = []
+    for f in facades:
+        h = hidden.get(f.id, {})
+        out.append(replace(
+            f,
+            visible_window_area_m2=_less(f.window_area_m2, h.get(SemanticClass.WINDOW, 0.0)),
+            visible_wall_area_m2=_less(f.wall_area_m2, h.get(SemanticClass.WALL, 0.0)),
+            visible_door_area_m2=_less(f.door_area_m2, h.get(SemanticClass.DOOR, 0.0)),
+        ))
+    return tuple(out)
+
+
+def _less(area_m2: float, hidden_m2: float) -> float:
+    """``area_m2 - hidden_m2``; a hidden area under :data:`HIDDEN_NOISE_M2` is polygon round-off."""
+    return float(area_m2) if hidden_m2 < HIDDEN_NOISE_M2 else float(area_m2 - hidden_m2)
 
 
 def assemble_layout(

@@ -15,7 +15,7 @@ from typing import Any, Literal
 import numpy as np
 
 from dataset.core.truth import Building, BuildingType
-from dataset.core.wwr import wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.families.building_assembly import assemble_building, facade_truths
 from dataset.families.facade_geometry import Opening, WallSpec, drop_near, window_grid
 from dataset.families.prism import ground_face, overhang_roof_faces, parapet_roof_faces, prism_walls
@@ -117,8 +117,8 @@ def grid_prism_walls(
 def grid_prism_wwr(walls: list[WallSpec]) -> float:
     """Whole-building WWR of walls from their parameters (cheap: no mesh)."""
     facades = facade_truths(walls)
-    return wwr_from_areas(*(sum(getattr(f, f"{c}_area_m2") for f in facades)
-                            for c in ("window", "wall", "door")))
+    return ClassAreas(*(sum(getattr(f, f"{c}_area_m2") for f in facades)
+                        for c in ("window", "wall", "door"))).wwr
 
 
 def grid_prism_building(

@@ -1,9 +1,10 @@
-"""Import the BuildNet3D BlenderProc generator's (and dataparser's) layout as project scenes.
+"""The BuildNet3D BlenderProc generator's (and dataparser's) layout as a source of scenes.
 
-``python -m dataset.generate --buildnet3d PATH --out DIR`` calls :func:`import_blenderproc`
-when PATH holds this layout (:func:`find_scenes`): a folder with ``meta_data.json`` and
-``images/`` and ``semantic/`` (the dataparser) or ``semantics/`` (the generator) beside it,
-or a folder of such folders. One scene ``DIR/<folder name>`` per folder. The facts and
+``python -m dataset.generate --buildnet3d PATH --out DIR`` reads PATH with
+:data:`BLENDERPROC_SOURCE` when it holds this layout (:func:`find_scenes`): a folder with
+``meta_data.json`` and ``images/`` and ``semantic/`` (the dataparser) or ``semantics/`` (the
+generator) beside it, or a folder of such folders. One scene ``DIR/<folder name>`` per folder
+(:func:`import_scene` writes it). The facts and
 where they come from (EPFL-IMOS/buildnet3d, file:line) are in docs/importing.md.
 
 - labels: colour masks (the generator) or single-channel ids (the dataparser), ids 0
@@ -25,25 +26,26 @@ where they come from (EPFL-IMOS/buildnet3d, file:line) are in docs/importing.md.
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
 
-from dataset.core.camera import Intrinsics
 from dataset.core.classes import SemanticClass
 from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL, Split
 from dataset.core.scene_record import Scene
-from dataset.importers.buildnet3d import (
-    ImportedView,
-    facade_ids_from_walls,
-    write_atomically,
-    write_scene_views,
-)
+from dataset.importers.buildnet3d import ImportedView, facade_ids_from_walls, write_scene_views
 from dataset.importers.depth_facades import facades_from_depth
+from dataset.importers.meta_data_file import (
+    META_DATA_FILE,
+    MetaData,
+    MetaDataFrame,
+    read_json_file,
+    read_meta_data_file,
+)
+from dataset.importers.source import NoOptions, SceneEntry, Source
 from dataset.scenes.labels import ClassMapping, class_mapping, read_remapped_labels
 
 DEPTH_UNIT_M = 0.001
@@ -62,41 +64,33 @@ def find_scenes(path: str | Path) -> list[Path]:
     return sorted(p for p in path.iterdir() if p.is_dir() and _is_scene(p))
 
 
-def import_blenderproc(path: str | Path, out_root: str | Path, *,
-                       overwrite: bool = False) -> list[Path]:
-    """Import every BlenderProc-layout folder at ``path`` into ``out_root/<folder name>``.
-
-    Each scene is written atomically (:func:`dataset.buildnet3d.write_atomically`); an
-    existing scene is kept unless ``overwrite``.
+def read_blenderproc(path: str | Path, options: NoOptions) -> tuple[SceneEntry, ...]:
+    """One scene entry per BlenderProc-layout folder at ``path``, named by the folder.
 
     Raises
     ------
     ValueError
-        ``path`` holds no such folder, or a file is missing or malformed.
+        ``path`` holds no such folder.
     """
     scenes = find_scenes(path)
     if not scenes:
         raise ValueError(f"{path} holds no BlenderProc-layout folder (meta_data.json with "
                          "images/ and semantic/ or semantics/ beside it)")
-    out_root = Path(out_root)
-    return [write_atomically(out_root / d.name, lambda tmp, d=d: import_scene(d, tmp),
-                             overwrite=overwrite) for d in scenes]
+    return tuple(SceneEntry(d.name, partial(import_scene, d)) for d in scenes)
 
 
 def import_scene(folder: Path, out_dir: Path) -> Scene:
-    """Write the BlenderProc-layout ``folder`` as a scene in ``out_dir``; return it."""
-    meta = _read_json(folder / "meta_data.json")
+    """Write the BlenderProc-layout ``folder`` as a scene in ``out_dir``; return it.
+
+    Raises
+    ------
+    ValueError
+        A file is missing or malformed (the message names it).
+    """
+    meta = read_meta_data_file(folder / META_DATA_FILE)
     mapping = scene_class_mapping(folder)
     masks = folder / "semantic" if (folder / "semantic").is_dir() else folder / "semantics"
-    try:
-        width, height = int(meta["width"]), int(meta["height"])
-        frames = list(meta["frames"])
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ValueError(f"{folder / 'meta_data.json'} lacks width, height or frames: "
-                         f"{exc!r}") from None
-    if not frames:
-        raise ValueError(f"{folder / 'meta_data.json'} has no frames")
-    read = [_read_frame(folder, masks, fr, width, height, mapping) for fr in frames]
+    read = [_read_frame(folder, masks, meta, fr, mapping) for fr in meta.frames]
     walls = facades_from_depth([(v.labels, v.depth_z_m, v.intrinsics, v.world_from_camera)
                                 for v in read])
     views = [replace(v, facade_ids=facade_ids_from_walls(
@@ -115,7 +109,7 @@ def scene_class_mapping(folder: Path) -> ClassMapping:
     path = folder / "segmentation_data.json"
     if not path.is_file():
         return renderer
-    seg = _read_json(path)
+    seg = read_json_file(path)
     if not isinstance(seg, dict) or not seg:
         raise ValueError(f"{path} must map class names to RGB colours")
     names = tuple(seg)
@@ -161,47 +155,35 @@ def split_from_name(name: str) -> Split:
     return EVAL_SPLIT if EVAL_SPLIT in name else TRAIN_PROTOCOL
 
 
-def _read_frame(folder: Path, masks: Path, fr: dict[str, Any], width: int, height: int,
+def _read_frame(folder: Path, masks: Path, meta: MetaData, fr: MetaDataFrame,
                 mapping: ClassMapping) -> ImportedView:
+    if fr.segmentation_path is None:
+        raise ValueError(f"{meta.file}: frame {fr.rgb_path!r} lacks segmentation_path")
+    generator = fr.pose_key == "camera_to_world"
+    intr = meta.intrinsics(fr, BLENDER_PIXEL_CENTRE_SHIFT if generator else 0.0)
+    segmentation = masks / fr.segmentation_path
     try:
-        rgb = str(fr["rgb_path"])
-        generator = "camera_to_world" in fr
-        pose = np.asarray(fr["camera_to_world"] if generator else fr["camtoworld"], float)
-        k = np.asarray(fr["intrinsics"], dtype=np.float64)
-        segmentation = str(fr["segmentation_path"])
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ValueError(f"{folder / 'meta_data.json'}: frame {fr.get('rgb_path', '?')!r} "
-                         f"lacks {exc!r} (rgb_path, segmentation_path, camtoworld or "
-                         "camera_to_world, intrinsics)") from None
-    if pose.shape == (3, 4):
-        pose = np.vstack([pose, [0.0, 0.0, 0.0, 1.0]])
-    if pose.shape != (4, 4) or k.shape not in ((3, 3), (4, 4)):
-        raise ValueError(f"frame {rgb}: pose must be 4x4 and intrinsics 3x3 or 4x4, got "
-                         f"{pose.shape} and {k.shape}")
-    shift = BLENDER_PIXEL_CENTRE_SHIFT if generator else 0.0
-    intr = Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]) + shift,
-                      float(k[1, 2]) + shift, width, height)
-    try:
-        labels = read_remapped_labels(masks / segmentation, mapping)
+        labels = read_remapped_labels(segmentation, mapping)
     except ValueError as exc:
-        raise ValueError(f"{masks / segmentation}: {exc}") from None
-    stem = Path(rgb).stem
-    depth_file = (folder / fr["depth_path"] if fr.get("depth_path")
+        raise ValueError(f"{segmentation}: {exc}") from None
+    stem = Path(fr.rgb_path).stem
+    depth_file = (folder / fr.depth_path if fr.depth_path
                   else folder / "depths" / f"{stem}_depth.png")
-    return ImportedView(stem, folder / "images" / rgb, intr, pose, split_from_name(Path(rgb).name),
-                        labels, read_mm_depth_m(depth_file, labels),
+    return ImportedView(stem, folder / "images" / fr.rgb_path, intr, fr.camera_to_world,
+                        split_from_name(Path(fr.rgb_path).name), labels,
+                        read_mm_depth_m(depth_file, labels),
                         np.zeros(labels.shape, dtype=np.int32))
 
 
 def _is_scene(folder: Path) -> bool:
-    return ((folder / "meta_data.json").is_file() and (folder / "images").is_dir()
+    return ((folder / META_DATA_FILE).is_file() and (folder / "images").is_dir()
             and ((folder / "semantic").is_dir() or (folder / "semantics").is_dir()))
 
 
-def _read_json(path: Path) -> Any:
-    if not path.is_file():
-        raise ValueError(f"{path} does not exist")
-    try:
-        return json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path} is not valid JSON: {exc}") from None
+BLENDERPROC_SOURCE = Source(
+    name="buildnet3d-blenderproc", flag="--buildnet3d",
+    help="a BlenderProc generator or dataparser folder of the official BuildNet3D "
+         "(meta_data.json with images/ and semantic/ or semantics/ beside it) or a folder of "
+         "them: one scene per folder, as rendered",
+    detect=lambda path: bool(find_scenes(path)), read=read_blenderproc,
+)

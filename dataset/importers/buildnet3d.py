@@ -1,10 +1,11 @@
-"""Import the BuildNet3D-dataset Blender generator's output as project scenes.
+"""The BuildNet3D-dataset Blender generator's output as a source of scenes.
 
-``python -m dataset.generate --buildnet3d PATH --out DIR`` calls it through
-:func:`dataset.importers.official.import_official`.
-PATH is the generator's output root (``images/building{i}/meta_data.json`` for every
-building) or one ``images/building{i}`` folder. One scene folder ``DIR/building{i}`` per
-building; the facts of the format and where they come from are in docs/importing.md.
+``python -m dataset.generate --buildnet3d PATH --out DIR`` reads PATH with
+:data:`BUILDNET3D_SOURCE` when it holds this layout (:func:`find_buildings`): the generator's
+output root (``images/building{i}/meta_data.json`` for every building) or one
+``images/building{i}`` folder. One scene folder ``DIR/building{i}`` per building
+(:func:`import_building` writes it); the facts of the format and where they come from are in
+docs/importing.md.
 
 - labels: colour masks ``masks/building{i}/building_{i}_{v}_mask0001.png``, colours
   resolved through ``segmentation_data.json`` and the generator palette
@@ -26,28 +27,32 @@ building; the facts of the format and where they come from are in docs/importing
 
 from __future__ import annotations
 
-import json
 import re
 import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import cv2
 import numpy as np
+import shapely
 from shapely.geometry import LineString
 from shapely.ops import polygonize, unary_union
 
 from dataset.core.camera import Intrinsics, pixel_centres, unproject_depth_to_world
 from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
-from dataset.core.mesh import write_labelled_ply
+from dataset.core.mesh import LabelledMesh, write_labelled_ply
 from dataset.core.protocols import IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEPTH_RELATIVE_STEP_KEY, Frame, Scene
 from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
+from dataset.core.wwr import ClassAreas
 from dataset.importers.buildnet3d_model import read_segmented_model
+from dataset.importers.meta_data_file import META_DATA_FILE, read_json_file, read_meta_data_file
+from dataset.importers.source import NoOptions, SceneEntry, Source
+from dataset.rendering.section import SNAP_GRID_M
 from dataset.scenes.images import (
     DEPTH_MAX_UNITS,
     read_rgb,
@@ -69,6 +74,7 @@ PLANE_TOLERANCE_M = 0.3
 """A pixel lies on a wall if its point is this close to the wall's plane and extent
 (windows sit in shallow reveals; the HDR depth is good to about 0.4 % of the depth)."""
 MULTI_VIEWS = 5
+_INCOMPLETE = ": not a complete BuildNet3D-dataset output"
 HORIZONTAL_Z = 0.5
 """A listed wall whose direction has |z| above this (of its length) is a horizontal face."""
 
@@ -81,15 +87,7 @@ def find_buildings(path: str | Path) -> list[tuple[Path, int]]:
     ValueError
         ``path`` holds neither layout of the generator.
     """
-    path = Path(path)
-    match = re.fullmatch(r"building(\d+)", path.name)
-    if match and (path / "meta_data.json").is_file():
-        return [(path.parent.parent, int(match.group(1)))]
-    found = sorted(
-        (int(m.group(1)), p.parent)
-        for p in (path / "images").glob("building*/meta_data.json")
-        if (m := re.fullmatch(r"building(\d+)", p.parent.name))
-    )
+    found = _buildings_under(Path(path))
     if not found:
         raise ValueError(
             f"{path} holds no BuildNet3D building: expected images/building<i>/meta_data.json "
@@ -97,24 +95,24 @@ def find_buildings(path: str | Path) -> list[tuple[Path, int]]:
             "meta_data.json with images/ and semantic/ or semantics/ beside it, in it or in "
             "its sub-folders (BlenderProc generator or dataparser)"
         )
-    return [(path, index) for index, _ in found]
+    return found
 
 
-def import_buildnet3d(path: str | Path, out_root: str | Path, *,
-                      overwrite: bool = False) -> list[Path]:
-    """Import every building of this generator's layout under ``path`` into ``out_root``;
-    return the scene folders (:func:`dataset.importers.official.import_official` picks the
-    layout).
+def _buildings_under(path: Path) -> list[tuple[Path, int]]:
+    match = re.fullmatch(r"building(\d+)", path.name)
+    if match and (path / META_DATA_FILE).is_file():
+        return [(path.parent.parent, int(match.group(1)))]
+    found = sorted(
+        int(m.group(1)) for p in (path / "images").glob(f"building*/{META_DATA_FILE}")
+        if (m := re.fullmatch(r"building(\d+)", p.parent.name)))
+    return [(path, index) for index in found]
 
-    Each scene is written into a temporary folder and renamed when finished, so a scene
-    folder with its final name is always complete. An existing scene is kept unless
-    ``overwrite``.
-    """
-    out_root = Path(out_root)
-    return [write_atomically(out_root / f"building{index}",
-                             lambda tmp, root=root, index=index: import_building(root, index, tmp),
-                             overwrite=overwrite)
-            for root, index in find_buildings(path)]
+
+def read_buildnet3d(path: str | Path, options: NoOptions) -> tuple[SceneEntry, ...]:
+    """One scene entry per building of this generator's layout under ``path``, named
+    ``building{i}`` (:func:`find_buildings`'s errors)."""
+    return tuple(SceneEntry(f"building{index}", partial(import_building, root, index))
+                 for root, index in find_buildings(path))
 
 
 def write_atomically(final: Path, write: Callable[[Path], object], *,
@@ -140,20 +138,22 @@ def write_atomically(final: Path, write: Callable[[Path], object], *,
 
 
 def import_building(root: Path, index: int, out_dir: Path) -> Scene:
-    """Write building ``index`` of the generator output ``root`` as a scene in ``out_dir``."""
+    """Write building ``index`` of the generator output ``root`` as a scene in ``out_dir``.
+
+    Raises
+    ------
+    ValueError
+        A file is missing or malformed (the message names it).
+    """
     images = root / "images" / f"building{index}"
-    meta = _read_json(images / "meta_data.json")
-    _check_segmentation_colours(_read_json(images / "segmentation_data.json"),
-                                images / "segmentation_data.json")
+    seg = images / "segmentation_data.json"
+    _check_segmentation_colours(read_json_file(seg, _INCOMPLETE), seg)
+    meta = read_meta_data_file(images / META_DATA_FILE)
     walls = read_walls(root / "wwr_information" / f"building{index}_wwr.json")
-    width, height = int(meta["width"]), int(meta["height"])
     views = []
-    for fr in meta["frames"]:
-        stem = Path(fr["rgb_path"]).stem  # building_{i}_{v}
-        k = np.asarray(fr["intrinsics"], dtype=np.float64)
-        intr = Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]),
-                          width, height)
-        pose = np.asarray(fr["camtoworld"], dtype=np.float64)
+    for fr in meta.frames:
+        stem = Path(fr.rgb_path).stem  # building_{i}_{v}
+        intr, pose = meta.intrinsics(fr), fr.camera_to_world
         labels = read_remapped_labels(root / "masks" / f"building{index}" /
                                       f"{stem}_mask0001.png", class_mapping("generator"))
         depth = read_hdr_depth_m(root / "depths" / f"building{index}" / f"{stem}_depth0001.hdr")
@@ -162,10 +162,11 @@ def import_building(root: Path, index: int, out_dir: Path) -> Scene:
     scene = write_scene_views(out_dir, views, [w["normal"] for w in walls],
                               {"source": "BuildNet3D-dataset", "source_building": index,
                                DEPTH_RELATIVE_STEP_KEY: HDR_RELATIVE_STEP})
-    write_building(out_dir / "building.json", building_truth(walls, f"building{index}"))
-    model = root / "model" / f"{index}_segmented.ply"
-    if model.is_file():
-        write_labelled_ply(out_dir / "mesh.ply", read_segmented_model(model, walls))
+    model_path = root / "model" / f"{index}_segmented.ply"
+    model = read_segmented_model(model_path, walls) if model_path.is_file() else None
+    write_building(out_dir / "building.json", building_truth(walls, f"building{index}", model))
+    if model is not None:
+        write_labelled_ply(out_dir / "mesh.ply", model)
     return scene
 
 
@@ -223,7 +224,7 @@ def read_walls(path: Path) -> list[dict[str, Any]]:
     Each wall: ``center`` (3,), ``normal`` (3,) outward unit, ``domain`` (3, 2) min/max
     x/y/z, ``wwr`` (window / opaque wall), ``area`` (opaque wall, m²); plus ``overall_wwr``.
     """
-    data = _read_json(path)
+    data = read_json_file(path, _INCOMPLETE)
     walls = []
     for key, w in data.items():
         if key == "overall":
@@ -289,31 +290,52 @@ def facade_ids_from_walls(labels: np.ndarray, depth_z_m: np.ndarray, intrinsics:
     return out
 
 
-def building_truth(walls: list[dict[str, Any]], building_id: str) -> BuildingTruth:
-    """Our ``building.json`` truth from the generator's walls (no doors: it has none)."""
+def building_truth(walls: list[dict[str, Any]], building_id: str,
+                   model: LabelledMesh | None = None) -> BuildingTruth:
+    """Our ``building.json`` truth from the generator's walls (no doors: it has none).
+
+    A wall's gross facade is its rectangle, the horizontal extent of its ``domain`` times
+    its height: the generator's wall faces are whole rectangles with the window modules
+    set through them (its ``area`` is that rectangle, and its ``wwr`` window / gross like
+    ours); a wall cut around its windows has the same rectangle. Its window area is
+    ``wwr * area``, or, with the segmented ``model``, the area of the window faces on that
+    wall (:func:`dataset.importers.buildnet3d_model.facade_ids_of_faces`): the generator's
+    per-wall list can count a window on two walls (one that reaches across a neighbouring
+    wall's plane), its overall WWR counts it once, and so does the model. Opaque wall =
+    gross - window.
+    """
+    model_window = None
+    if model is not None:
+        on_window = model.face_label == SemanticClass.WINDOW
+        model_window = np.bincount(model.face_facade[on_window],
+                                   weights=model.face_areas_m2()[on_window],
+                                   minlength=len(walls) + 1)
     facades = []
     for w, wall in enumerate(walls):
         d = wall["domain"]
-        window = wall["wwr"] * wall["area"]
-        gross = gross_facade_area_m2(wall["area"], window, 0.0)
+        width = float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0]))
+        height = float(d[2, 1] - d[2, 0])
+        window = (wall["wwr"] * wall["area"] if model_window is None
+                  else float(model_window[w + 1]))
+        areas = ClassAreas(window, max(0.0, width * height - window), 0.0)
         facades.append(FacadeTruth(
-            id=w + 1, normal=tuple(float(x) for x in wall["normal"]),
-            width_m=float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0])),
-            height_m=float(d[2, 1] - d[2, 0]), window_area_m2=window,
-            wall_area_m2=wall["area"], door_area_m2=0.0, facade_area_m2=gross,
-            wwr=wwr_from_areas(window, wall["area"], 0.0)))
+            id=w + 1, normal=tuple(float(x) for x in wall["normal"]), width_m=width,
+            height_m=height, window_area_m2=window, wall_area_m2=areas.wall_m2,
+            door_area_m2=0.0, facade_area_m2=areas.gross_m2, wwr=areas.wwr))
     window = sum(f.window_area_m2 for f in facades)
     wall_area = sum(f.wall_area_m2 for f in facades)
-    gross = gross_facade_area_m2(wall_area, window, 0.0)
+    areas = ClassAreas(window, wall_area, 0.0)
     z0 = min(float(w["domain"][2, 0]) for w in walls)
     height = max(float(w["domain"][2, 1]) for w in walls) - z0
     footprint = _footprint(walls)
     return BuildingTruth(
         id=building_id, type="imported", floors=max(1, round(height / 3.0)), height_m=height,
-        window_area_m2=window, facade_area_m2=gross, wall_area_m2=wall_area, door_area_m2=0.0,
-        wwr=wwr_from_areas(window, wall_area, 0.0), footprint=polygon_to_geojson(footprint),
+        window_area_m2=window, facade_area_m2=areas.gross_m2, wall_area_m2=wall_area,
+        door_area_m2=0.0, wwr=areas.wwr, footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area), facades=tuple(facades),
-        extra={"source": "BuildNet3D-dataset wwr_information",
+        extra={"source": "BuildNet3D-dataset wwr_information"
+               + ("" if model is None else " and the segmented model's window faces"),
+               "generator_wall_window_area_m2": [w["wwr"] * w["area"] for w in walls],
                "generator_overall_wwr": walls[0]["overall_wwr"],
                "floors_estimated_from_height_3m": True, "ground_z_m": z0})
 
@@ -327,7 +349,8 @@ def _footprint(walls: list[dict[str, Any]]):
         c = wall["center"][:2]
         half = 0.5 * float(np.hypot(d[0, 1] - d[0, 0], d[1, 1] - d[1, 0]))
         lines.append(LineString([c - half * along, c + half * along]))
-    faces = list(polygonize(unary_union(lines)))
+    # The generator's coordinates are float32 (-1.4999998807907104 for -1.5): snap the ends.
+    faces = list(polygonize(shapely.set_precision(unary_union(lines), SNAP_GRID_M)))
     if not faces:
         raise ValueError("the walls of wwr_information do not close a footprint")
     return unary_union(faces)
@@ -360,10 +383,9 @@ def _depth_unit_m(max_depth_m: float) -> float:
     return unit
 
 
-def _read_json(path: Path) -> Any:
-    if not path.is_file():
-        raise ValueError(f"{path} does not exist: not a complete BuildNet3D-dataset output")
-    try:
-        return json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path} is not valid JSON: {exc}") from None
+BUILDNET3D_SOURCE = Source(
+    name="buildnet3d-blender", flag="--buildnet3d",
+    help="the official BuildNet3D-dataset Blender generator's output root or one "
+         "images/building<i> folder: one scene per building, as rendered",
+    detect=lambda path: bool(_buildings_under(Path(path))), read=read_buildnet3d,
+)

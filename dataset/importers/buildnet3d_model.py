@@ -28,6 +28,8 @@ WINDOW_RECESS_M = 0.5
 """A window face parallel to a wall lies within this of its plane (window modules are set
 into the wall)."""
 PARALLEL_COS = 0.99
+"""A face belongs to a wall when its outward normal is within ~8 deg of the wall's (a window
+module is a box through the wall: its back face, facing in, is not on the facade)."""
 
 
 def read_segmented_model(path: str | Path, walls: list[dict[str, Any]]) -> LabelledMesh:
@@ -38,24 +40,31 @@ def read_segmented_model(path: str | Path, walls: list[dict[str, Any]]) -> Label
     Raises
     ------
     ValueError
-        The file is missing, unreadable, has no faces or no vertex colours.
+        The file is missing, unreadable, has no faces or no vertex colours (Blender's
+        exporter writes them beside UV coordinates ``s``, ``t``: both are read).
     """
-    import trimesh
+    from trimesh.exchange.ply import load_ply
 
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"segmented model {path} does not exist")
     try:
-        mesh = trimesh.load(path, process=False, force="mesh")
+        with path.open("rb") as f:
+            # fix_texture=False: Blender writes UVs (s, t) beside the colours; trimesh would
+            # otherwise make a textured mesh and drop the vertex colours.
+            ply = load_ply(f, fix_texture=False)
     except Exception as exc:  # trimesh raises many kinds on a bad file
         raise ValueError(f"{path} is not a readable PLY mesh: {exc}") from None
-    colours = getattr(mesh.visual, "vertex_colors", None)
-    if len(mesh.faces) == 0 or colours is None or len(colours) != len(mesh.vertices):
-        raise ValueError(f"{path} has no faces or no vertex colours: not a segmented model")
+    faces = np.asarray(ply.get("faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
+    vertices = np.asarray(ply.get("vertices", np.zeros((0, 3))), dtype=np.float64)
+    colours = ply.get("vertex_colors")
+    if len(faces) == 0:
+        raise ValueError(f"{path} has no faces: not a segmented model")
+    if colours is None or len(colours) != len(vertices):
+        raise ValueError(f"{path} has no vertex colours (red, green, blue): not a segmented "
+                         "model; export it with Blender's PLY exporter and colours on")
     vertex_class = classes_from_colours(np.asarray(colours)[:, :3])
-    faces = np.asarray(mesh.faces, dtype=np.int64)
     face_class = _majority(vertex_class[faces])
-    vertices = np.asarray(mesh.vertices, dtype=np.float64)
     return LabelledMesh(vertices, faces, face_class,
                         facade_ids_of_faces(vertices[faces], face_class, walls))
 
@@ -75,7 +84,7 @@ def classes_from_colours(rgb: np.ndarray) -> np.ndarray:
 def facade_ids_of_faces(triangles_m: np.ndarray, face_class: np.ndarray,
                         walls: list[dict[str, Any]]) -> np.ndarray:
     """(F,) int32 facade id of (F, 3, 3) triangles: the wall whose plane a wall or window
-    face is parallel to and lies on (0 = none)."""
+    face lies on, facing the same way (0 = none)."""
     e1 = triangles_m[:, 1] - triangles_m[:, 0]
     e2 = triangles_m[:, 2] - triangles_m[:, 0]
     normal = np.cross(e1, e2)
@@ -90,7 +99,7 @@ def facade_ids_of_faces(triangles_m: np.ndarray, face_class: np.ndarray,
         dist = np.abs((centre - wall["center"]) @ wall["normal"])
         lo = wall["domain"][:, 0] - tolerance[:, None]
         hi = wall["domain"][:, 1] + tolerance[:, None]
-        ok = (candidate & (np.abs(normal @ wall["normal"]) >= PARALLEL_COS)
+        ok = (candidate & (normal @ wall["normal"] >= PARALLEL_COS)
               & (dist <= tolerance) & np.all((centre >= lo) & (centre <= hi), axis=1)
               & (dist < best))
         out[ok], best[ok] = w + 1, dist[ok]

@@ -15,13 +15,19 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
-from shapely.geometry import Polygon
+from shapely.errors import GEOSException
 
-from dataset.core.mesh import LabelledMesh, plane_bases
+from dataset.core.mesh import LabelledMesh
+from dataset.importers.face_pieces import (
+    MIN_PIECE_M2,
+    face_frames,
+    face_polygon_uv,
+    replace_faces,
+    triangulate_uv,
+)
 
 PLANE_DECIMALS_NORMAL = 6  # faces whose unit normals agree to 1e-6 are parallel
 PLANE_DECIMALS_OFFSET_M = 5  # ... and whose plane offsets agree to 10 um, coplanar
-MIN_PIECE_M2 = 1e-8  # covered or uncovered parts smaller than this are ignored
 BOX_TOLERANCE_M = 1e-9  # bounding boxes that overlap by less than this do not touch
 
 
@@ -52,11 +58,10 @@ def split_touching_faces(
     twin : (F',) bool
         Pieces that an earlier same-facing face already covers.
     """
-    normals = mesh.face_normals()
+    normals, basis_u, basis_v, _ = face_frames(mesh)
     tri = mesh.triangles_m
     offsets = np.einsum("ij,ij->i", normals, tri[:, 0])
     lo, hi = tri.min(axis=1), tri.max(axis=1)
-    basis_u, basis_v = plane_bases(normals)
     extent = hi - lo  # a face flat along an axis overlaps along it whatever its bounds
     keys = np.concatenate([np.round(normals, PLANE_DECIMALS_NORMAL) + 0.0,
                            np.round(offsets, PLANE_DECIMALS_OFFSET_M)[:, None] + 0.0], axis=1)
@@ -71,9 +76,9 @@ def split_touching_faces(
                       | (extent[f] < BOX_TOLERANCE_M) | (extent[i] < BOX_TOLERANCE_M), axis=1)
         return f[near]
 
-    new_vertices: list[np.ndarray] = []
+    piece_uv: list[np.ndarray] = []
     piece_parent: list[int] = []
-    piece_twin: list[bool] = []
+    piece_twin: list[np.ndarray] = []
     cut = np.zeros(len(tri), dtype=bool)
     for i in np.flatnonzero(which & (np.linalg.norm(normals, axis=1) > 0.5)):
         opposite = overlapping(by_plane.get(tuple(-keys[i] + 0.0)), i)
@@ -81,42 +86,38 @@ def split_touching_faces(
         same = same[same < i]
         if len(opposite) == 0 and len(same) == 0:
             continue
-        u, v = basis_u[i], basis_v[i]
-        origin = tri[i, 0]
-        uv = np.stack([u, v], axis=1)  # (3, 2)
-        own = Polygon((tri[i] - origin) @ uv)
+        parts = _cover_twin_rest(tri, i, opposite, same, basis_u[i], basis_v[i])
+        if parts is None:
+            continue  # GEOS could not cut it: the rays decide the face as a whole
+        triangulated = [(triangulate_uv(part), is_twin) for part, is_twin in parts
+                        if part.area >= MIN_PIECE_M2]
+        if any(t is None for t, _ in triangulated):
+            continue
+        cut[i] = True
+        for t, is_twin in triangulated:
+            piece_uv.append(t)
+            piece_parent.append(int(i))
+            piece_twin.append(np.full(len(t), is_twin))
+    if not cut.any():
+        return mesh, np.arange(len(tri)), np.zeros(len(tri), dtype=bool)
+    out, parent, twin = replace_faces(mesh, cut, piece_uv, piece_parent, piece_twin)
+    return out, parent, twin
+
+
+def _cover_twin_rest(tri: np.ndarray, i: int, opposite: np.ndarray, same: np.ndarray,
+                     u: np.ndarray, v: np.ndarray):
+    """Face i's parts in its plane coordinates: [(covered, False), (twin, True), (rest,
+    False)], or None when there is nothing to cut or GEOS fails on the polygons."""
+    own = face_polygon_uv(tri[i], u, v)
+    origin, uv = tri[i, 0], np.stack([u, v], axis=1)
+    try:
         cover = shapely.union_all(shapely.polygons((tri[opposite] - origin) @ uv)
                                   ).intersection(own)
         twin = shapely.union_all(shapely.polygons((tri[same] - origin) @ uv)
                                  ).intersection(own).difference(cover)
         rest = own.difference(cover).difference(twin)
-        if twin.area < MIN_PIECE_M2 and min(cover.area, rest.area) < MIN_PIECE_M2:
-            continue  # not covered, or wholly covered by touching faces: the rays decide
-        cut[i] = True
-        for part, is_twin in ((cover, False), (twin, True), (rest, False)):
-            if part.area < MIN_PIECE_M2:
-                continue
-            triangles = shapely.get_parts(shapely.constrained_delaunay_triangles(part))
-            xy = shapely.get_coordinates(shapely.get_exterior_ring(triangles)).reshape(-1, 4, 2)
-            new_vertices.append(origin + xy[:, :3, :1] * u + xy[:, :3, 1:2] * v)  # (T, 3, 3)
-            piece_parent.extend([int(i)] * len(xy))
-            piece_twin.extend([is_twin] * len(xy))
-    if not cut.any():
-        return mesh, np.arange(len(tri)), np.zeros(len(tri), dtype=bool)
-    corners = np.concatenate(new_vertices)
-    piece_parent_a = np.asarray(piece_parent, dtype=np.int64)
-    # Each piece turns the way its parent does.
-    turn = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    flip = np.einsum("ij,ij->i", turn, normals[piece_parent_a]) < 0
-    corners[flip] = corners[flip][:, ::-1]
-    keep = np.flatnonzero(~cut)
-    parent = np.concatenate([keep, piece_parent_a])
-    twins = np.concatenate([np.zeros(len(keep), dtype=bool), np.asarray(piece_twin)])
-    vertices = np.concatenate([mesh.vertices_m, corners.reshape(-1, 3)])
-    pieces = len(mesh.vertices_m) + np.arange(3 * len(corners)).reshape(-1, 3)
-    faces = np.concatenate([mesh.faces[keep], pieces])
-    return (LabelledMesh(vertices, faces, mesh.face_label[parent], mesh.face_facade[parent]),
-            parent, twins)
-
-
-
+    except GEOSException:
+        return None
+    if twin.area < MIN_PIECE_M2 and min(cover.area, rest.area) < MIN_PIECE_M2:
+        return None  # not covered, or wholly covered by touching faces: the rays decide
+    return [(cover, False), (twin, True), (rest, False)]

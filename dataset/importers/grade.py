@@ -1,4 +1,4 @@
-"""Ground level of an imported building: cut its mesh at grade, and check bodies are closed.
+"""Ground level of an imported building: cut its mesh at grade.
 
 An exported building often reaches below the ground (foundation walls, a crawl space, a
 basement). :func:`split_at_height` cuts every face that crosses the ground plane into
@@ -68,34 +68,3 @@ def split_at_height(mesh: LabelledMesh, z_m: float) -> tuple[LabelledMesh, np.nd
     vertices = np.concatenate([v, np.asarray(new_vertices).reshape(-1, 3)])
     faces = np.concatenate([f[keep], np.asarray(pieces, dtype=np.int64).reshape(-1, 3)])
     return LabelledMesh(vertices, faces, mesh.face_label[parent], mesh.face_facade[parent]), parent
-
-
-def edge_balance(faces: np.ndarray) -> tuple[int, int]:
-    """How far a triangle mesh is from a set of closed, consistently oriented bodies.
-
-    Every edge of a closed, outward-oriented body is walked once in each direction, so in a
-    union of such bodies -- touching, sharing edges and faces, overlapping -- every edge is
-    walked as often one way as the other, however many faces meet there.
-
-    Parameters
-    ----------
-    faces : (F, 3) int
-        Faces over merged vertices (coincident vertices share an index).
-
-    Returns
-    -------
-    n_open
-        Edges used an odd number of times (holes, cracks, T-junctions).
-    n_misoriented
-        Other edges walked more often one way than the other (flipped faces).
-    """
-    directed = np.asarray(faces, dtype=np.int64)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    forward = directed[:, 0] < directed[:, 1]
-    key = np.sort(directed, axis=1)
-    edges, inverse = np.unique(key, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    total = np.bincount(inverse, minlength=len(edges))
-    net = np.bincount(inverse, weights=np.where(forward, 1, -1), minlength=len(edges))
-    n_open = int((total % 2 == 1).sum())
-    n_misoriented = int(((total % 2 == 0) & (net != 0)).sum())
-    return n_open, n_misoriented

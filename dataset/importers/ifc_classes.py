@@ -35,6 +35,8 @@ NOT_GEOMETRY = (
     "IfcDistributionPort",
 )
 """Products that are no part of the building's envelope and are not imported (subtypes too)."""
+EXTERNAL_FLAGS: dict[str, str] = {"IfcWall": "Pset_WallCommon", "IfcDoor": "Pset_DoorCommon"}
+"""Entity -> property set whose ``IsExternal`` tells an outer element from an interior one."""
 
 
 def read_class_overrides(path: str | Path) -> dict[str, SemanticClass | str]:
@@ -63,14 +65,33 @@ def read_class_overrides(path: str | Path) -> dict[str, SemanticClass | str]:
     return out
 
 
-def class_of_element(element, overrides: dict[str, SemanticClass | str] | None = None
-                     ) -> SemanticClass | str:
+def interior_flagged_entities(model) -> frozenset[str]:
+    """The entities of :data:`EXTERNAL_FLAGS` whose ``IsExternal`` the model sets both ways.
+
+    Only there does ``IsExternal = False`` tell an interior element: some exporters set it
+    False on every element (a Revit export in the corpus does, windows included).
+    """
+    from ifcopenshell.util.element import get_pset
+
+    out = set()
+    for entity, pset in EXTERNAL_FLAGS.items():
+        values = {get_pset(e, pset, "IsExternal") for e in model.by_type(entity)}
+        if True in values and False in values:
+            out.add(entity)
+    return frozenset(out)
+
+
+def class_of_element(element, overrides: dict[str, SemanticClass | str] | None = None,
+                     interior_flagged: frozenset[str] = frozenset()) -> SemanticClass | str:
     """Our class of an IFC product, or :data:`SKIP` for one that is not imported.
 
     Order: an override by GlobalId, by entity (the most specific listed supertype wins);
     products in :data:`NOT_GEOMETRY`; a plate of a curtain wall is window and its other
-    parts (members) wall; a slab of type ROOF is roof; :data:`ENTITY_CLASSES`; a part of
-    an aggregate (a roof's slabs, a wall's parts) takes the class of its whole; else other.
+    parts (members) wall; a slab of type ROOF is roof; a wall or door of an entity in
+    ``interior_flagged`` (:func:`interior_flagged_entities`) whose ``IsExternal`` is False
+    is other (an interior partition or door is no facade); :data:`ENTITY_CLASSES`; a part
+    of an aggregate (a roof's slabs, a wall's parts) takes the class of its whole; else
+    other.
     """
     overrides = overrides or {}
     if element.GlobalId in overrides:
@@ -85,12 +106,21 @@ def class_of_element(element, overrides: dict[str, SemanticClass | str] | None =
         return SemanticClass.WINDOW if element.is_a("IfcPlate") else SemanticClass.WALL
     if element.is_a("IfcSlab") and getattr(element, "PredefinedType", None) == "ROOF":
         return SemanticClass.ROOF
+    for entity in interior_flagged:
+        if element.is_a(entity) and _is_external(element, EXTERNAL_FLAGS[entity]) is False:
+            return SemanticClass.OTHER
     for entity, cls in ENTITY_CLASSES.items():
         if element.is_a(entity):
             return cls
     if whole is not None and not any(whole.is_a(e) for e in NOT_GEOMETRY):
-        return class_of_element(whole, overrides)
+        return class_of_element(whole, overrides, interior_flagged)
     return SemanticClass.OTHER
+
+
+def _is_external(element, pset: str) -> bool | None:
+    from ifcopenshell.util.element import get_pset
+
+    return get_pset(element, pset, "IsExternal")
 
 
 def _supertypes(element) -> list[str]:

@@ -1,14 +1,13 @@
-"""How a labelled mesh becomes a building: :class:`ImportConfig` and its command-line options.
+"""How a labelled mesh becomes a building: :class:`ImportConfig`, one place for the import
+options of the mesh and IFC sources (:mod:`dataset.importers.building_file`).
 
-One place for the import options, shared by ``python -m dataset.importer`` and
-``python -m dataset.generate --mesh/--ifc``: every field of :class:`ImportConfig` is an
-option (``--ground-z``, ``--footprint-height-m``, ...), with the field's default.
+``python -m dataset.generate --mesh/--ifc`` and ``python -m dataset.importer`` offer every
+field as an option (``--ground-z``, ``--footprint-height-m``, ...; :mod:`dataset.source_args`).
 """
 
 from __future__ import annotations
 
-import argparse
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from dataset.importers.mesh_files import UpAxis
 from dataset.rendering.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
@@ -65,55 +64,3 @@ class ImportConfig:
             raise ValueError(
                 f"min_escape_fraction must be in (0, 1], got {self.min_escape_fraction}"
             )
-
-
-_HELP = {
-    "up_axis": "the file's up axis; glTF from Blender is y",
-    "ground_z_m": "ground level in the file (metres, after --up-axis): what lies below is "
-                  "underground, never facade (default: the lowest point; IFC: the lowest "
-                  "storey's floor)",
-    "max_tilt_deg": "faces tilted further than this from upright are no facade",
-    "angle_tolerance_deg": "faces within this angle of a facade's direction join it",
-    "offset_tolerance_m": "parallel planes closer than this are one facade",
-    "gap_tolerance_m": "coplanar wall pieces further apart than this are two facades",
-    "min_facade_width_m": "narrower face groups (reveals) belong to no facade",
-    "rays_per_sample": "visibility rays per sample point (4 points per face)",
-    "min_escape_fraction": "a face is seen from outside if this share of its rays escape",
-    "ray_offset_m": "rays start this far off the surface",
-    "footprint_height_m": "footprint section height above the ground",
-    "floor_height_m": "storey height for the floor count",
-}
-_FLAGS = {"ground_z_m": "--ground-z"}
-
-
-def add_import_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add one option per :class:`ImportConfig` field to ``parser`` (``recentre`` becomes
-    ``--keep-position``)."""
-    group = parser.add_argument_group("import options (docs/importing.md)")
-    defaults = ImportConfig()
-    for field in fields(ImportConfig):
-        if field.name == "recentre":
-            group.add_argument("--keep-position", action="store_true",
-                               help="keep the file's coordinates instead of centring the "
-                               "building on the origin with its ground at z = 0")
-            continue
-        flag = _FLAGS.get(field.name, "--" + field.name.replace("_", "-"))
-        default = getattr(defaults, field.name)
-        kind = {"up_axis": str, "rays_per_sample": int}.get(field.name, float)
-        group.add_argument(flag, dest=f"import_{field.name}", type=kind, default=default,
-                           metavar=None if field.name == "up_axis" else "X",
-                           choices=("z", "y") if field.name == "up_axis" else None,
-                           help=f"{_HELP[field.name]} (default: {default})")
-
-
-def import_config_from_args(args: argparse.Namespace) -> ImportConfig:
-    """The :class:`ImportConfig` that options added by :func:`add_import_arguments` ask for.
-
-    Raises
-    ------
-    ValueError
-        An option out of range.
-    """
-    values = {f.name: getattr(args, f"import_{f.name}") for f in fields(ImportConfig)
-              if f.name != "recentre"}
-    return ImportConfig(recentre=not args.keep_position, **values)

@@ -1,15 +1,13 @@
 """A user's own labelled building mesh -> :class:`dataset.core.truth.Building` with derived truth.
 
-Steps (docs/importing.md): read the file (:mod:`dataset.importers.mesh_files`); check its bodies are
-closed and consistently oriented (they may touch or overlap) and carry facade classes; move
-it to the origin with its ground at z = 0 and cut the faces that cross the ground
-(:mod:`dataset.importers.grade`) and where another body's face lies against them
-(:mod:`dataset.importers.contact`); find the wall/window/door faces above the ground seen from
-outside
-(:mod:`dataset.rendering.visibility`, through :mod:`dataset.rendering.raycast`); group them into
-facades
-(:mod:`dataset.importers.facade_grouping`); sum areas per class and facade; cut the footprint
-``footprint_height_m`` above the ground (:mod:`dataset.rendering.section`).
+Steps (docs/importing.md): read the file (:mod:`dataset.importers.mesh_files`); check it carries
+facade classes; move it to the origin with its ground at z = 0; turn each body to face
+outwards (:mod:`dataset.importers.bodies`: closed, open, inside-out and single-face bodies
+are all normal input); cut the faces that cross the ground (:mod:`dataset.importers.grade`);
+find the wall/window/door faces above the ground seen from outside, cutting faces where
+other bodies touch or pass through them (:mod:`dataset.importers.exposure`); group them into
+facades (:mod:`dataset.importers.facade_grouping`); sum areas per class and facade; cut the
+footprint ``footprint_height_m`` above the ground (:mod:`dataset.rendering.section`).
 """
 
 from __future__ import annotations
@@ -23,17 +21,14 @@ from dataset.core.classes import FACADE_CLASSES, NO_FACADE, SemanticClass
 from dataset.core.footprint import polygon_to_geojson
 from dataset.core.mesh import LabelledMesh
 from dataset.core.truth import Building, BuildingTruth, FacadeTruth
-from dataset.core.wwr import gross_facade_area_m2, wwr_from_areas
-from dataset.importers.contact import split_touching_faces
+from dataset.core.wwr import ClassAreas
+from dataset.importers.bodies import orient_bodies
+from dataset.importers.exposure import exposed_faces, facade_candidates
 from dataset.importers.facade_grouping import FacadeGroup, facade_ids_of_faces, group_facades
-from dataset.importers.grade import edge_balance, split_at_height
-from dataset.importers.import_config import (
-    ImportConfig,
-)
+from dataset.importers.grade import split_at_height
+from dataset.importers.import_config import ImportConfig
 from dataset.importers.mesh_files import merge_vertices, read_labelled_mesh_file
-from dataset.rendering.raycast import Raycaster
 from dataset.rendering.section import cross_section_footprint
-from dataset.rendering.visibility import seen_from_outside
 
 CURVED_SPREAD_DEG = 1.0  # a facade whose face normals spread wider than this is curved
 
@@ -61,8 +56,9 @@ def import_labelled_mesh(
     Raises
     ------
     ValueError
-        Unreadable, empty, unlabelled, unknown class names, not closed, inconsistently
-        oriented, no facade classes, or no facade seen from outside.
+        Unreadable, empty, unlabelled, unknown class names, no facade classes, no facade
+        seen from outside, or no footprint. Open, overlapping, inside-out and single-face
+        bodies are accepted (counted in ``truth.extra["bodies"]``).
     """
     path = Path(path)
     config = ImportConfig() if config is None else config
@@ -74,13 +70,33 @@ def import_labelled_mesh(
     return building
 
 
+class NoFacadeError(ValueError):
+    """No wall, window or door face above the ground is seen from outside.
+
+    ``facade_class_parents`` are the facade-class faces above the ground (indices into the
+    mesh given to :func:`building_from_mesh`), for a caller that can name their elements."""
+
+    def __init__(self, message: str, facade_class_parents: np.ndarray):
+        super().__init__(message)
+        self.facade_class_parents = facade_class_parents
+
+
+class NoFootprintError(ValueError):
+    """The footprint section cuts no solid; ``section_parents`` are the faces (indices into
+    the input mesh) that cross its height."""
+
+    def __init__(self, message: str, section_parents: np.ndarray):
+        super().__init__(message)
+        self.section_parents = section_parents
+
+
 def building_from_mesh(
     mesh: LabelledMesh,
     *,
     building_id: str,
     source: Path,
     config: ImportConfig | None = None,
-    require_closed: bool = True,
+    body_group: np.ndarray | None = None,
     extra: dict | None = None,
 ) -> tuple[Building, np.ndarray]:
     """Derive a building's ground truth from its labelled mesh (z up, metres).
@@ -88,16 +104,16 @@ def building_from_mesh(
     Parameters
     ----------
     mesh
-        Closed bodies that may touch or overlap (vertices merged or not).
+        The building's bodies: closed or open, touching or overlapping, any orientation,
+        vertices merged or not.
     building_id
         The truth's ``id``.
     source
         The file it came from (named in errors and in the truth).
     config
         :class:`ImportConfig` (default: its defaults); ``ground_z_m`` is in the mesh's frame.
-    require_closed
-        Refuse a mesh whose bodies are not closed; when False, the edge counts are
-        recorded in ``truth.extra["open_edges"]`` instead.
+    body_group : (F,) int, optional
+        Element of each face (an IFC product): a body never spans two elements.
     extra
         More entries for the truth's ``extra``.
 
@@ -106,45 +122,38 @@ def building_from_mesh(
     building
         Mesh moved to the origin (ground at z = 0 unless ``recentre`` is off), faces that
         cross the ground cut there, facade ids 1..N; truth of type ``"imported"`` counting
-        only faces above the ground and seen from outside.
+        only faces above the ground and seen from outside. ``truth.extra["bodies"]`` counts
+        the bodies found (closed, open, sheets, turned inside out, rewound).
     parent : (F',) int64
         Index of each of its faces in ``mesh``.
+
+    Raises
+    ------
+    ValueError
+        No faces or no facade classes; :class:`NoFacadeError`; :class:`NoFootprintError`.
     """
     config = ImportConfig() if config is None else config
     mesh, kept = _drop_collapsed_faces(mesh)
-    open_edges = _check_mesh(source, mesh, require_closed=require_closed)
-    vertices, faces = mesh.vertices_m, mesh.faces
+    _check_mesh(source, mesh)
+    vertices = mesh.vertices_m
     ground_z = float(vertices[:, 2].min()) if config.ground_z_m is None else config.ground_z_m
     offset = np.zeros(3)
     if config.recentre:
         lo, hi = vertices.min(axis=0), vertices.max(axis=0)
         offset = -np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, ground_z])
         vertices = vertices + offset
-    if _signed_volume_m3(vertices, faces) < 0:  # inside-out export: every normal points in
-        faces = faces[:, ::-1].copy()
+    bodies = orient_bodies(vertices, mesh.faces,
+                           None if body_group is None else np.asarray(body_group)[kept])
     grade_z = ground_z + offset[2]
     mesh, parent = split_at_height(
-        LabelledMesh(vertices, faces, mesh.face_label, mesh.face_facade), grade_z
-    )
-    parent = kept[parent]
-    candidate = _facade_candidates(mesh, grade_z)
-    raycaster = Raycaster(mesh)
-    visible = _seen_from_outside(raycaster, candidate, config)
-    # Faces seen from outside that another body's face partly covers: cut them there and
-    # decide the pieces (a hidden face's pieces stay hidden; a twin is not counted).
-    mesh, touching_parent, twin = split_touching_faces(mesh, visible)
-    if len(touching_parent) != len(visible) or twin.any():
-        parent = parent[touching_parent]
-        piece = np.bincount(touching_parent)[touching_parent] > 1
-        raycaster = Raycaster(mesh)
-        visible = visible[touching_parent] & ~piece
-        visible |= _seen_from_outside(raycaster, piece & _facade_candidates(mesh, grade_z),
-                                      config)
-        visible &= ~twin  # counted once, on the earlier solid's face
+        LabelledMesh(vertices, bodies.faces, mesh.face_label, mesh.face_facade), grade_z)
+    exposure = exposed_faces(mesh, bodies.sheet[parent], grade_z, config)
+    mesh, visible, raycaster = exposure.mesh, exposure.visible, exposure.raycaster
+    parent = np.where(exposure.lid, -1, kept[parent[np.maximum(exposure.parent, 0)]])
     vertices, faces = mesh.vertices_m, mesh.faces
     areas, normals = mesh.face_areas_m2(), mesh.face_normals()
     is_facade_class = np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
-    candidate = _facade_candidates(mesh, grade_z)
+    candidate = facade_candidates(mesh, grade_z)
     groups = group_facades(
         mesh.triangles_m, normals, areas, visible,
         max_tilt_deg=config.max_tilt_deg,
@@ -154,32 +163,34 @@ def building_from_mesh(
         min_width_m=config.min_facade_width_m,
     )
     if not groups:
-        raise ValueError(
-            f"{source}: no wall, window or door faces above the ground (z = {ground_z:.3f} m), "
-            f"upright and seen from outside form a facade at least {config.min_facade_width_m} "
-            "m wide; check the labels, the ground height and that the normals point outwards"
-        )
+        raise _no_facade_error(source, mesh, areas, candidate, visible, ground_z, config,
+                               parent)
     face_facade = facade_ids_of_faces(groups, len(faces))
-    mesh = LabelledMesh(vertices, faces, mesh.face_label, face_facade)
+    labels = mesh.face_label
+    mesh = LabelledMesh(vertices, faces, labels, face_facade)
 
     facades = tuple(
         _facade_truth(i + 1, g, mesh, areas, normals) for i, g in enumerate(groups)
     )
-    height_m = float(vertices[:, 2].max()) - grade_z
-    footprint = cross_section_footprint(raycaster, grade_z + config.footprint_height_m)
+    height_m = float(mesh.triangles_m[~exposure.lid][:, :, 2].max()) - grade_z
+    footprint = _footprint(source, raycaster, grade_z, ground_z, config, parent)
+    # The virtual lid of a roofless model served the rays and the footprint; the file's
+    # own faces remain.
+    mesh = LabelledMesh(vertices, faces[~exposure.lid], labels[~exposure.lid],
+                        face_facade[~exposure.lid])
     window, wall, door = (sum(getattr(f, k) for f in facades)
                           for k in ("window_area_m2", "wall_area_m2", "door_area_m2"))
-    gross = gross_facade_area_m2(wall, window, door)
+    totals = ClassAreas(window, wall, door)
     truth = BuildingTruth(
         id=building_id,
         type="imported",
         floors=max(1, round(height_m / config.floor_height_m)),
         height_m=height_m,
         window_area_m2=window,
-        facade_area_m2=gross,
+        facade_area_m2=totals.gross_m2,
         wall_area_m2=wall,
         door_area_m2=door,
-        wwr=wwr_from_areas(window, wall, door),
+        wwr=totals.wwr,
         footprint=polygon_to_geojson(footprint),
         footprint_area_m2=float(footprint.area),
         facades=facades,
@@ -188,33 +199,51 @@ def building_from_mesh(
             "source_file": source.name,
             "offset_m": [float(x) for x in offset],
             "ground_z_m": ground_z,
-            "hidden_area_m2": _class_areas(mesh, areas, candidate & ~visible),
-            "below_grade_area_m2": _class_areas(mesh, areas, is_facade_class & ~candidate),
+            "hidden_area_m2": _class_areas(labels, areas, candidate & ~visible),
+            "below_grade_area_m2": _class_areas(labels, areas, is_facade_class & ~candidate),
             "unassigned_area_m2": _class_areas(
-                mesh, areas, visible & (face_facade == NO_FACADE)
+                labels, areas, visible & (face_facade == NO_FACADE)
             ),
-            **({} if require_closed else {"open_edges": open_edges}),
+            "bodies": {**bodies.counts, "sheet_faces_turned": exposure.turned_sheets,
+                       "virtual_lid": bool(exposure.lid.any())},
             "import_config": asdict(config),
             **(extra or {}),
         },
     )
-    return Building(mesh=mesh, truth=truth), parent
+    return Building(mesh=mesh, truth=truth), parent[~exposure.lid]
 
 
-def _facade_candidates(mesh: LabelledMesh, grade_z_m: float) -> np.ndarray:
-    """(F,) bool: wall, window and door faces above the ground."""
-    above = mesh.triangles_m[:, :, 2].mean(axis=1) > grade_z_m
-    return np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES]) & above
+def _footprint(source: Path, raycaster, grade_z: float, ground_z: float,
+               config: ImportConfig, parent: np.ndarray):
+    """The section ``footprint_height_m`` above the ground, or :class:`NoFootprintError`."""
+    z = grade_z + config.footprint_height_m
+    try:
+        return cross_section_footprint(raycaster, z)
+    except ValueError:
+        tri_z = raycaster.mesh.triangles_m[:, :, 2]
+        crossing = np.unique(parent[(tri_z.min(axis=1) < z) & (tri_z.max(axis=1) > z)])
+        raise NoFootprintError(
+            f"{source}: no footprint: the section {config.footprint_height_m} m above the "
+            f"ground (z = {ground_z + config.footprint_height_m:.3f} m in the file) cuts "
+            f"no solid body ({len(crossing)} faces cross that height). Set the ground "
+            "(--ground-z) to the building's ground floor, or the section height "
+            "(--footprint-height-m) to a height where its outer walls stand", crossing
+        ) from None
 
 
-def _seen_from_outside(raycaster: Raycaster, which: np.ndarray, config: ImportConfig
-                       ) -> np.ndarray:
-    """(F,) bool: faces in ``which`` that enough rays leave
-    (:func:`dataset.rendering.visibility.seen_from_outside`)."""
-    return seen_from_outside(raycaster, which, rays_per_sample=config.rays_per_sample,
-                             offset_m=config.ray_offset_m,
-                             min_escape_fraction=config.min_escape_fraction, ground=True,
-                             show_progress=True)
+def _no_facade_error(source: Path, mesh: LabelledMesh, areas: np.ndarray,
+                     candidate: np.ndarray, visible: np.ndarray, ground_z: float,
+                     config: ImportConfig, parent: np.ndarray) -> NoFacadeError:
+    hidden = float(areas[candidate & ~visible].sum())
+    below = float(areas[np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES])
+                        & ~candidate].sum())
+    return NoFacadeError(
+        f"{source}: no facade: {hidden:.1f} m² of wall, window and door faces lie above the "
+        f"ground (z = {ground_z:.3f} m in the file) and {below:.1f} m² below it, but no "
+        f"upright stretch of them at least {config.min_facade_width_m} m wide is seen from "
+        "outside. Set the ground (--ground-z) to the building's ground floor, and label "
+        "the outer surfaces of the walls, windows and doors as such",
+        np.unique(parent[candidate]))
 
 
 def _drop_collapsed_faces(mesh: LabelledMesh) -> tuple[LabelledMesh, np.ndarray]:
@@ -227,7 +256,7 @@ def _drop_collapsed_faces(mesh: LabelledMesh) -> tuple[LabelledMesh, np.ndarray]
                         mesh.face_facade[keep]), keep
 
 
-def _check_mesh(path: Path, mesh: LabelledMesh, *, require_closed: bool) -> dict[str, int]:
+def _check_mesh(path: Path, mesh: LabelledMesh) -> None:
     if len(mesh.faces) == 0:
         raise ValueError(f"{path} holds no faces; export the building's surfaces as triangles")
     if not np.isin(mesh.face_label, [int(c) for c in FACADE_CLASSES]).any():
@@ -236,26 +265,6 @@ def _check_mesh(path: Path, mesh: LabelledMesh, *, require_closed: bool) -> dict
             f"{', '.join(SemanticClass(c).name.lower() for c in np.unique(mesh.face_label))}); "
             "label the facade surfaces wall, window or door"
         )
-    n_open, n_flipped = edge_balance(merge_vertices(mesh.vertices_m, mesh.faces)[1])
-    if require_closed and n_open:
-        raise ValueError(
-            f"{path} is not a closed mesh: {n_open} open edge(s); every body (wall, window, "
-            "slab solid) must enclose a volume -- close its holes and snap T-junctions in the "
-            "authoring tool (Blender: select the body, 'Merge by Distance', 'Fill Holes'); "
-            "bodies may touch or overlap"
-        )
-    if require_closed and n_flipped:
-        raise ValueError(
-            f"{path}: faces are not consistently oriented ({n_flipped} edge(s) walked twice "
-            "the same way: some normals point inwards); recalculate normals outside in the "
-            "authoring tool (Blender: Mesh > Normals > Recalculate Outside)"
-        )
-    return {"open": n_open, "misoriented": n_flipped}
-
-
-def _signed_volume_m3(vertices_m: np.ndarray, faces: np.ndarray) -> float:
-    t = vertices_m[faces]
-    return float(np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])).sum() / 6.0)
 
 
 def _facade_truth(
@@ -267,7 +276,8 @@ def _facade_truth(
     }
     window, wall, door = (by_class[SemanticClass.WINDOW], by_class[SemanticClass.WALL],
                           by_class[SemanticClass.DOOR])
-    gross = gross_facade_area_m2(wall, window, door)
+    facade_areas = ClassAreas(window, wall, door)
+    gross = facade_areas.gross_m2
     z = mesh.triangles_m[f][:, :, 2]
     height = float(z.max() - z.min())
     h = normals[f, :2] / np.linalg.norm(normals[f, :2], axis=1, keepdims=True)
@@ -284,12 +294,10 @@ def _facade_truth(
         wall_area_m2=wall,
         door_area_m2=door,
         facade_area_m2=gross,
-        wwr=wwr_from_areas(window, wall, door),
+        wwr=facade_areas.wwr,
         curved=curved,
     )
 
 
-def _class_areas(mesh: LabelledMesh, areas: np.ndarray, keep: np.ndarray) -> dict[str, float]:
-    return {
-        c.name.lower(): float(areas[keep & (mesh.face_label == c)].sum()) for c in FACADE_CLASSES
-    }
+def _class_areas(labels: np.ndarray, areas: np.ndarray, keep: np.ndarray) -> dict[str, float]:
+    return {c.name.lower(): float(areas[keep & (labels == c)].sum()) for c in FACADE_CLASSES}

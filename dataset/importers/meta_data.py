@@ -21,7 +21,6 @@ remaps them
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any, Literal
@@ -29,9 +28,14 @@ from typing import Any, Literal
 import numpy as np
 
 from dataset.core.atomic import write_json_atomic
-from dataset.core.camera import Intrinsics
 from dataset.core.protocols import SPLITS, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEFAULT_DEPTH_UNIT_M, Frame, Scene
+from dataset.importers.meta_data_file import (
+    META_DATA_FILE,
+    MetaData,
+    MetaDataFrame,
+    read_meta_data_file,
+)
 from dataset.scenes.labels import (  # noqa: F401  (re-exported: the mappings lived here)
     ClassIds,
     ClassMapping,
@@ -42,7 +46,6 @@ from dataset.scenes.labels import (  # noqa: F401  (re-exported: the mappings li
 from dataset.scenes.scene_validation import validate_scene
 
 PoseConvention = Literal["opencv", "opengl"]
-META_DATA_FILE = "meta_data.json"
 OPENCV_FROM_OPENGL = np.diag([1.0, -1.0, -1.0, 1.0])
 """Right-multiply a camera-to-world pose by this to swap OpenGL <-> OpenCV camera axes."""
 
@@ -52,8 +55,8 @@ class MetaDataLayout:
     """Where a ``meta_data.json`` flavour keeps its files and how it writes poses.
 
     Folders are relative to the folder of ``meta_data.json`` and are prefixed to the
-    frame's paths on reading (and stripped on writing). ``normals_key`` names a frame's
-    normal image (``normal_path`` is read too).
+    frame's paths on reading (and stripped on writing). ``normals_key`` is the key a frame's
+    normal image is written under (either key is read).
     """
 
     pose_convention: PoseConvention = "opencv"
@@ -120,29 +123,19 @@ def read_meta_data(
         an invalid scene (:class:`dataset.scenes.scene_validation.InvalidSceneError`).
     """
     mapping = class_mapping(class_ids)
-    path = Path(path)
-    file = path / META_DATA_FILE if path.is_dir() else path
-    if not file.is_file():
-        raise ValueError(f"{file} does not exist; pass a meta_data.json or the folder holding one")
+    meta = read_meta_data_file(path)
     try:
-        meta = json.loads(file.read_text())
-        width, height = int(meta["width"]), int(meta["height"])
-        frames = tuple(
-            _frame_from_json(fr, width, height, layout) for fr in meta["frames"]
-        )
-    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError,
-            AttributeError, OverflowError) as exc:
-        raise ValueError(f"{file} is not a valid meta_data.json: {exc!r}") from exc
-    if not frames:
-        raise ValueError(f"{file} has no frames")
-    known = {"width", "height", "frames", "camera_model", "depth_unit_scale_factor",
-             "semantic_classes"}
+        frames = tuple(_frame(meta, fr, layout) for fr in meta.frames)
+        unit = float(meta.other.get("depth_unit_scale_factor", DEFAULT_DEPTH_UNIT_M))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{meta.file} is not a valid meta_data.json: {exc!r}") from exc
+    known = {"camera_model", "depth_unit_scale_factor", "semantic_classes"}
     scene = Scene(
-        root=file.parent,
+        root=meta.file.parent,
         frames=frames,
         semantic_classes=mapping.names,
-        depth_unit_scale_factor=float(meta.get("depth_unit_scale_factor", DEFAULT_DEPTH_UNIT_M)),
-        extra={k: v for k, v in meta.items() if k not in known},
+        depth_unit_scale_factor=unit,
+        extra={k: v for k, v in meta.other.items() if k not in known},
     )
     if validate:
         validate_scene(scene)
@@ -224,35 +217,23 @@ def opencv_from_opengl(world_from_camera: np.ndarray) -> np.ndarray:
     return pose @ OPENCV_FROM_OPENGL
 
 
-def _frame_from_json(
-    fr: dict[str, Any], width: int, height: int, layout: MetaDataLayout
-) -> Frame:
-    name = fr.get("rgb_path", "?")
-    pose = np.asarray(fr["camtoworld"] if "camtoworld" in fr else fr["camera_to_world"],
-                      dtype=np.float64)
-    if pose.shape not in ((4, 4), (3, 4)):
-        raise ValueError(f"frame {name}: camtoworld must be 4x4 or 3x4, got {pose.shape}")
-    if pose.shape == (3, 4):
-        pose = np.vstack([pose, [0.0, 0.0, 0.0, 1.0]])
+def _frame(meta: MetaData, fr: MetaDataFrame, layout: MetaDataLayout) -> Frame:
+    pose = fr.camera_to_world
     if layout.pose_convention == "opencv":
         pose = opencv_from_opengl(pose)
-    k = np.asarray(fr["intrinsics"], dtype=np.float64)
-    if k.shape not in ((3, 3), (4, 4)):
-        raise ValueError(f"frame {name}: intrinsics must be 3x3 or 4x4, got {k.shape}")
-    split = fr.get("split", TRAIN_PROTOCOL)
+    split = fr.split if fr.split is not None else TRAIN_PROTOCOL
     if split not in SPLITS:
-        raise ValueError(f"frame {name}: unknown split {split!r}; expected one of {SPLITS}")
+        raise ValueError(f"frame {fr.rgb_path}: unknown split {split!r}; expected one of {SPLITS}")
     return Frame(
-        file_path=_join(layout.rgb_dir, fr["rgb_path"]),
+        file_path=_join(layout.rgb_dir, fr.rgb_path),
         world_from_camera=pose,
-        intrinsics=Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]),
-                              width, height),
+        intrinsics=meta.intrinsics(fr),
         split=split,
-        facade_id=int(fr["facade_id"]) if fr.get("facade_id") is not None else None,
-        depth_file_path=_join(layout.depth_dir, fr.get("depth_path")),
-        semantic_file_path=_join(layout.segmentation_dir, fr.get("segmentation_path")),
-        normal_file_path=fr.get(layout.normals_key, fr.get("normal_path")),
-        instance_file_path=fr.get("instance_path"),
+        facade_id=fr.facade_id,
+        depth_file_path=_join(layout.depth_dir, fr.depth_path),
+        semantic_file_path=_join(layout.segmentation_dir, fr.segmentation_path),
+        normal_file_path=fr.normals_path,
+        instance_file_path=fr.instance_path,
     )
 
 

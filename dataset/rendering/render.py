@@ -22,6 +22,7 @@ from dataset.core.camera import Intrinsics, rays_world
 from dataset.core.mesh import LabelledMesh
 from dataset.rendering.raycast import Raycaster
 from dataset.rendering.shading import RgbConfig, shade
+from dataset.rendering.textures import TextureSet
 
 GROUND_Z_M = 0.0
 GROUND_TOLERANCE_M = 1e-6  # hits this far below the ground still count (float round-off)
@@ -102,9 +103,11 @@ def render_view(
     config: RgbConfig | None = None,
     seed: int = 0,
     supersampling: int = 1,
+    textures: TextureSet | None = None,
 ) -> tuple[GroundTruthImages, np.ndarray]:
     """Ground truth and RGB of one view, as :func:`render_ground_truth` and :func:`render_rgb`
-    give them, casting the primary rays once when ``supersampling`` is 1."""
+    give them, casting the primary rays once when ``supersampling`` is 1. ``textures``: the
+    mesh faces' own materials for the RGB (:mod:`dataset.rendering.textures`)."""
     if not isinstance(supersampling, int | np.integer) or supersampling < 1:
         raise ValueError(f"supersampling must be an integer >= 1, got {supersampling!r}")
     config = RgbConfig() if config is None else config
@@ -122,6 +125,7 @@ def render_view(
         config=config,
         seed=seed,
         pixel_angle_rad=1.0 / max(fine.fx, fine.fy),
+        textures=textures,
     ).reshape(fine.height, fine.width, 3)
     if s > 1:
         h, w = intrinsics.height, intrinsics.width

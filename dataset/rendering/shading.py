@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from dataset.core.classes import NO_FACADE, SemanticClass
+from dataset.rendering.textures import TextureSet, texture_albedo
 
 if TYPE_CHECKING:
     from dataset.rendering.raycast import Raycaster
@@ -171,11 +172,14 @@ def shade(
     config: RgbConfig,
     seed: int,
     pixel_angle_rad: float,
+    textures: TextureSet | None = None,
 ) -> np.ndarray:
     """Linear radiance (N, 3) along rays whose first hits are ``face`` (-1: miss) at ``t``.
 
     ``pixel_angle_rad`` (about 1 / focal length in pixels) sets the pixel's footprint on
-    the surface, below which texture detail fades to its mean (no moiré).
+    the surface, below which texture detail fades to its mean (no moiré). ``textures``: the
+    source's own materials (:mod:`dataset.rendering.textures`); a face that has one shows
+    it instead of the procedural material (a textured window shows its texture, not glass).
 
     Parameters
     ----------
@@ -223,9 +227,13 @@ def shade(
     footprint_m = t[hit] * np.linalg.norm(dirs[hit], axis=1) * pixel_angle_rad / cos_i
     s, v = surface_coords(p, n_front)
     albedo = _albedo(label, facade, s, v, look, footprint_m)
+    textured = np.zeros(len(hit), dtype=bool)
+    if textures is not None:
+        textured, source_albedo = texture_albedo(textures, f, p, footprint_m)
+        albedo[textured] = source_albedo[textured]
     radiance = albedo * irradiance
 
-    glass = (label == SemanticClass.WINDOW) & (facade != NO_FACADE)
+    glass = (label == SemanticClass.WINDOW) & (facade != NO_FACADE) & ~textured
     if glass.any():
         radiance[glass] = _glass(
             d[glass], n_front[glass], s[glass], v[glass], lit[glass], irradiance[glass], look,

@@ -1,7 +1,8 @@
 """A scene folder's ``transforms.json`` read into a :class:`~dataset.core.scene_record.Scene` and
 written back (DESIGN.md).
 
-Every method reads scenes through :func:`read_scene`.
+Methods read scenes through :func:`read_method_input`, which never opens ``building.json``;
+:func:`read_scene` (the truth too) is for the dataset's tools and for metrics.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from dataset.core.atomic import write_json_atomic
 from dataset.core.camera import Intrinsics
 from dataset.core.classes import CLASS_NAMES
+from dataset.core.method_input import ALL_INPUTS, Input, MethodInput, method_input
 from dataset.core.protocols import SPLITS, TRAIN_PROTOCOL
 from dataset.core.scene_record import DEFAULT_DEPTH_UNIT_M, Frame, Scene
 from dataset.core.truth import read_building
@@ -27,16 +29,42 @@ def read_scene(root: str | Path, *, validate: bool = True) -> Scene:
 
     The scene is validated (:func:`dataset.scenes.scene_validation.validate_scene`): paths
     inside the folder, finite proper poses and intrinsics, every image present with
-    its declared size. ``validate=False`` is for tools that only read the JSON (a
-    method must never pass it).
+    its declared size. ``validate=False`` is for tools that only read the JSON.
 
     Raises
     ------
     ValueError
-        If the folder or its ``transforms.json`` is missing or malformed, or the scene
-        is invalid (:class:`dataset.scenes.scene_validation.InvalidSceneError`).
+        If the folder or its ``transforms.json`` is missing or malformed, the truth is
+        malformed, or the scene is invalid
+        (:class:`dataset.scenes.scene_validation.InvalidSceneError`).
     """
-    root = Path(root)
+    scene = _read_transforms(Path(root))
+    building_json = scene.root / "building.json"
+    if building_json.is_file():
+        scene = replace(scene, building=read_building(building_json))
+    if validate:
+        validate_scene(scene)
+    return scene
+
+
+def read_method_input(root: str | Path, inputs: tuple[Input, ...] = ALL_INPUTS) -> MethodInput:
+    """Read a scene folder as a method declaring ``inputs`` sees it
+    (:func:`dataset.core.method_input.method_input`), from ``transforms.json`` alone, and
+    validate the files it names as :func:`read_scene` does.
+
+    Raises
+    ------
+    ValueError
+        As :func:`read_scene`; ``building.json``, ``mesh.ply`` and the facade-id and normal
+        images are never opened, so their state changes nothing.
+    """
+    view = method_input(_read_transforms(Path(root)), inputs)
+    validate_scene(view)
+    return view
+
+
+def _read_transforms(root: Path) -> Scene:
+    """The scene of ``root/transforms.json``, without truth and unvalidated."""
     tf = root / "transforms.json"
     if not tf.is_file():
         raise ValueError(
@@ -51,22 +79,17 @@ def read_scene(root: str | Path, *, validate: bool = True) -> Scene:
     except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError,
             AttributeError, OverflowError) as exc:
         raise ValueError(f"{tf} is malformed: {exc}") from exc
-    building_json = root / "building.json"
     known = {
         "fl_x", "fl_y", "cx", "cy", "w", "h", "camera_model", "frames",
         "semantic_classes", "depth_unit_scale_factor",
     }
-    scene = Scene(
+    return Scene(
         root=root,
         frames=frames,
         semantic_classes=classes,
         depth_unit_scale_factor=unit,
-        building=read_building(building_json) if building_json.is_file() else None,
         extra={k: v for k, v in meta.items() if k not in known},
     )
-    if validate:
-        validate_scene(scene)
-    return scene
 
 
 def write_transforms(root: str | Path, scene: Scene) -> None:

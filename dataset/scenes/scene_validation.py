@@ -17,6 +17,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 
 import numpy as np
 
+from dataset.core.method_input import MethodInput
 from dataset.core.scene_record import Frame, Scene
 from dataset.scenes.images import read_depth_m, read_labels
 from dataset.scenes.labels import mapping_for_classes, read_remapped_labels
@@ -36,7 +37,7 @@ class InvalidSceneError(ValueError):
     """The scene's files contradict ``transforms.json`` or hold impossible values."""
 
 
-def validate_scene(scene: Scene) -> None:
+def validate_scene(scene: Scene | MethodInput) -> None:
     """Check every frame of ``scene`` (see the module docstring); header reads only.
 
     Raises
@@ -99,7 +100,7 @@ def resolve_inside(root: Path, relative: str) -> Path:
     return target
 
 
-def read_frame_labels(scene: Scene, frame: Frame) -> np.ndarray:
+def read_frame_labels(scene: Scene | MethodInput, frame: Frame) -> np.ndarray:
     """(H, W) uint8 project class ids of ``frame``'s semantic image, checked against the scene.
 
     The one way methods read labels: a scene that declares the project's classes
@@ -145,7 +146,7 @@ MAX_DEPTH_HOLE_FRACTION = 0.5
 building's pixels without depth means depth and labels do not belong together."""
 
 
-def read_frame_depth_m(scene: Scene, frame: Frame, labels: np.ndarray | None = None
+def read_frame_depth_m(scene: Scene | MethodInput, frame: Frame, labels: np.ndarray | None = None
                        ) -> np.ndarray:
     """(H, W) float32 z-depth (m) of ``frame``, checked: finite, >= 0, and > 0 on at least
     half (:data:`MAX_DEPTH_HOLE_FRACTION`) of the pixels where ``labels`` (if given) show

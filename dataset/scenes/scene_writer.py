@@ -13,7 +13,7 @@ always finished. ``transforms.json`` records the config and seed under
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +34,7 @@ from dataset.core.provenance import (
 from dataset.core.scene_record import Frame, Scene
 from dataset.core.truth import Building, write_building
 from dataset.executors.worker_pool import worker_pool
+from dataset.rendering.context import ViewMeshes
 from dataset.rendering.facade_views import FacadeViewConfig, ideal_views, multi_views
 from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views
 from dataset.rendering.render import Raycaster, render_view
@@ -64,7 +65,10 @@ class GenerateConfig:
     are always exact at pixel centres). ``depth_unit_scale_factor``: metres per unit
     of the 16-bit depth PNGs; a scene whose views reach farther than 65535 units uses
     the next coarser 1-2-5 step and records it in ``transforms.json``.
-    ``ideal``/``multi``: whether to add those facade views.
+    ``ideal``/``multi``: whether to add those facade views. ``context``: render the
+    buildings the source places around the building (``Building.context``) as occluders in
+    every view, each camera moved in front of the neighbours in its way
+    (:mod:`dataset.rendering.context`); the truth is the same either way.
     """
 
     resolution: int = 512
@@ -75,6 +79,7 @@ class GenerateConfig:
     depth_unit_scale_factor: float = 0.001
     ideal: bool = True
     multi: bool = True
+    context: bool = False
     orbit: OrbitConfig = field(default_factory=OrbitConfig)
     facade_views: FacadeViewConfig = field(default_factory=FacadeViewConfig)
     rgb: RgbConfig = field(default_factory=RgbConfig)
@@ -173,10 +178,11 @@ def generate_scene(
     _check_scene_name(name)
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
-    raycaster = Raycaster(building.mesh)
+    meshes = ViewMeshes(building, context=config.context)
     k = config.intrinsics()
-    views = plan_views(building, raycaster, config, seed=seed)
-    unit = depth_unit_for(config.depth_unit_scale_factor, raycaster,
+    views = [replace(v, world_from_camera=meshes.street_pose(v.world_from_camera))
+             for v in plan_views(building, meshes.alone, config, seed=seed)]
+    unit = depth_unit_for(config.depth_unit_scale_factor, meshes.rendered,
                           [v.world_from_camera for v in views])
     scene_dir = Path(out_dir) / name
     with atomic_directory(scene_dir) as tmp:
@@ -185,7 +191,7 @@ def generate_scene(
             if workers == 1:
                 frames = []
                 for view in views:
-                    frames.append(_render_view(tmp, raycaster, k, view, config, seed, unit))
+                    frames.append(_render_view(tmp, meshes, k, view, config, seed, unit))
                     bar.update()
             else:
                 frames = _render_in_pool(building, tmp, k, views, config, seed, unit, workers,
@@ -255,11 +261,12 @@ def scene_is_finished(
 
 
 def _render_view(
-    tmp: Path, raycaster: Raycaster, k: Intrinsics, view: PlannedView, config: GenerateConfig,
+    tmp: Path, meshes: ViewMeshes, k: Intrinsics, view: PlannedView, config: GenerateConfig,
     seed: int, unit: float,
 ) -> Frame:
-    gt, rgb = render_view(raycaster, k, view.world_from_camera, config=config.rgb, seed=seed,
-                          supersampling=config.supersampling)
+    gt, rgb = render_view(meshes.rendered, k, view.world_from_camera, config=config.rgb,
+                          seed=seed, supersampling=config.supersampling,
+                          textures=meshes.textures)
     paths = {folder: f"{folder}/{view.name}.png"
              for folder in ("images", "depth", "semantics", "normals", "instances")}
     write_rgb(tmp / paths["images"], rgb)
@@ -281,7 +288,7 @@ def _render_in_pool(
 ) -> list[Frame]:
     """Render ``views`` in chunks over ``workers`` processes; frames in view order."""
     chunk = max(1, min(_POOL_CHUNK, len(views) // workers))
-    jobs = [(building.mesh, tmp, k, views[i : i + chunk], config, seed, unit)
+    jobs = [(building, tmp, k, views[i : i + chunk], config, seed, unit)
             for i in range(0, len(views), chunk)]
     frames: list[Frame] = []
     with worker_pool(min(workers, len(jobs))) as pool:
@@ -292,9 +299,10 @@ def _render_in_pool(
 
 
 def _render_chunk(job: tuple) -> list[Frame]:
-    mesh, tmp, k, views, config, seed, unit = job
-    raycaster = Raycaster(mesh)  # a BVH per chunk: milliseconds for these meshes
-    return [_render_view(tmp, raycaster, k, view, config, seed, unit) for view in views]
+    building, tmp, k, views, config, seed, unit = job
+    # BVHs per chunk: milliseconds for a building, a fraction of a second with its context
+    meshes = ViewMeshes(building, context=config.context)
+    return [_render_view(tmp, meshes, k, view, config, seed, unit) for view in views]
 
 
 def _check_scene_name(name: str) -> None:

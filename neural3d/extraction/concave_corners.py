@@ -6,8 +6,8 @@ camera whether the corner is sharp or filled, so nothing in the images undoes
 it. The fillet's triangles lie more than ``plane_slab_m`` in front of either
 wall's plane and face neither squarely, so neither wall counts them, and the
 probes of :mod:`neural3d.extraction.occluded_facade` start inside the fillet
-and see nothing there. On l_shaped_03 of the paper preset each inner wall lost
-a 0.55 m strip over its 13.45 m height (7 m² of 100).
+and see nothing there: each inner wall loses a strip as wide as the fillet
+over its whole height.
 
 Two facade planes A and B of :class:`neural3d.extraction.facade_planes.FacadePlanes`
 form a concave corner when their normals are between 45 and 135 degrees apart
@@ -67,18 +67,17 @@ def concave_corner_fill(
     planes : the mesh's facade planes (``weight`` (F, K): the faces each plane counts)
     probes, labels : each plane's probe grid and (U, Z) known classes (-1 unknown), from
         :func:`neural3d.extraction.occluded_facade.probe_planes` and
-        :func:`~neural3d.extraction.occluded_facade.occluded_facade_labels`
+        :func:`~neural3d.extraction.occluded_facade.seen_cell_labels` (or, with the
+        occluded fill, :func:`~neural3d.extraction.occluded_facade.occluded_facade_labels`)
     cell_m : the probe grids' cell; reach_m : how far in front rays start
-    max_gap_m : the longest run filled, and how far in front a covering surface may be
+    max_gap_m : (> 0) the longest run filled, and how far in front a covering surface may be
     strip_m : ``MeasureConfig.curve_strip_m``, the strip whose tilt the fillet would skew
 
     Returns
     -------
-    :class:`CornerFill`; nothing changed when ``max_gap_m`` is 0.
+    :class:`CornerFill`
     """
     area_m2 = np.zeros((len(probes), NUM_CLASSES))
-    if max_gap_m <= 0:
-        return CornerFill(area_m2, planes)
     weight, residual = planes.weight.copy(), planes.residual.copy()
     triangles = raycaster.mesh.triangles_m
     normal_xy = triangle_normals(triangles)[:, :2]

@@ -7,12 +7,11 @@ field (``metrics.methods``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Literal
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from neural3d.extraction.measure_config import MeasureConfig
+from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 from neural3d.field.chunks import DEFAULT_CHUNK_POINTS
 
 
@@ -21,8 +20,9 @@ class ExtractConfig:
     """Everything that turns a trained field into measurements (the one source of defaults).
 
     ``resolution`` is the number of marching-cubes samples along the scene box's
-    longest side. The footprint is the zero contour of the SDF averaged over the
-    planes ``footprint_heights_m`` above the ground (z = 0): above the least
+    longest side; ``chunk_points`` the most points one call of the field takes
+    (:mod:`neural3d.field.chunks`). The footprint is the zero contour of the SDF
+    averaged over the planes ``footprint_heights_m`` above the ground (z = 0): above the least
     constrained band of a trained field (no camera sees the base from below and
     the scene box is cut at z = 0), below balconies and overhangs (a first
     floor is at least 2.7 m up; a plane cutting a balcony slab is one of seven).
@@ -30,6 +30,9 @@ class ExtractConfig:
     out (a low building), keeping at least the lowest. Its grid spacing
     ``footprint_cell_m`` is, when None, half the mesh's voxel, so the footprint
     is as fine as the mesh and costs (2 x resolution)² queries per plane.
+    ``roofed_hole_fill`` switches the last footprint stage
+    (:func:`neural3d.extraction.footprint.fill_roofed_holes`); ``measure.stages`` the
+    mesh measurement's.
     """
 
     resolution: int = 256
@@ -40,22 +43,10 @@ class ExtractConfig:
     footprint_max_height_fraction: float = 0.5
     footprint_cell_m: float | None = None
     footprint_min_area_m2: float = 1.0
+    roofed_hole_fill: bool = True
     measure: MeasureConfig = field(default_factory=MeasureConfig)
-    # whole-building window/wall/door areas: from the mesh's vertex labels, or read from the
-    # fields on each facade plane's grid (neural3d.extraction.plane_sampling)
-    areas: Literal["mesh", "planes"] = "mesh"
-    # split each mesh triangle's facade area among wall/window/door by the semantic head's
-    # probabilities at its corners, not by their argmax (neural3d.extraction.facade_split)
-    soft_facade_split: bool = True
-    plane_cell_m: float = 0.1
-    plane_depth_m: float = 0.5  # probed in front of and behind each plane
 
     def __post_init__(self) -> None:
-        if self.areas not in ("mesh", "planes"):
-            raise ValueError(f"areas must be 'mesh' or 'planes', got {self.areas!r}")
-        if self.plane_cell_m <= 0 or self.plane_depth_m <= 0:
-            raise ValueError(f"plane_cell_m and plane_depth_m must be > 0, got "
-                             f"{self.plane_cell_m}, {self.plane_depth_m}")
         if self.resolution < 8:
             raise ValueError(f"resolution must be >= 8, got {self.resolution}")
         if self.chunk_points < 1:
@@ -84,3 +75,25 @@ def footprint_cell_m(box_min_m: np.ndarray, box_max_m: np.ndarray, config: Extra
         return config.footprint_cell_m
     longest_m = float(np.max(np.asarray(box_max_m) - np.asarray(box_min_m)))
     return 0.5 * longest_m / (config.resolution - 1)
+
+
+# Every stage with a switch, in the order it runs: the mesh measurement's, then the footprint's.
+STAGES = (*(f.name for f in fields(MeasureStages)), "roofed_hole_fill")
+
+
+def without_stages(config: ExtractConfig, *stages: str) -> ExtractConfig:
+    """``config`` with these stages (names from :data:`STAGES`) off, and every measurement
+    stage that needs one of them (:meth:`MeasureStages.without`).
+
+    Raises
+    ------
+    ValueError
+        If a name is not a stage.
+    """
+    unknown = sorted(set(stages) - set(STAGES))
+    if unknown:
+        raise ValueError(f"unknown stage(s) {unknown}; stages: {', '.join(STAGES)}")
+    mesh_stages = [s for s in stages if s != "roofed_hole_fill"]
+    measure = replace(config.measure, stages=config.measure.stages.without(*mesh_stages))
+    return replace(config, measure=measure,
+                   roofed_hole_fill=config.roofed_hole_fill and "roofed_hole_fill" not in stages)

@@ -1,7 +1,7 @@
-"""Facade planes of a semantic mesh, and each triangle's shadow on them (``count="projected"``).
+"""Facade planes of a semantic mesh, and each triangle's shadow on them (the plane projection).
 
-Geometry helpers shared with :mod:`neural3d.extraction.measure` (face normals, azimuths)
-live here too, so that the dependency runs one way: measure -> facade_planes.
+Geometry helpers shared with :mod:`neural3d.extraction.facade_groups` (azimuths, circular
+means) live here too, so that the dependency runs one way: facade_groups -> facade_planes.
 """
 
 from __future__ import annotations
@@ -57,8 +57,9 @@ def project_onto_facade_planes(
     ----------
     vertices_m : (V, 3) float64, world metres; faces : (F, 3) int64, outward
     facade_area_m2 : (F,) wall + window + door share of each triangle's area
-        (``neural3d.extraction.measure.class_area_m2``)
-    group : (F,) facade group from ``neural3d.extraction.measure.group_facade_faces`` (-1 none)
+        (``neural3d.extraction.facade_groups.class_area_m2``)
+    group : (F,) facade group (-1 none) from
+        ``neural3d.extraction.facade_groups.group_facade_faces``
     config : ``neural3d.extraction.measure_config.MeasureConfig``
     """
     normal = triangle_normals(vertices_m[faces])

@@ -1,6 +1,6 @@
 """A triangle's facade area shared among wall, window and door by class probabilities.
 
-The vertex-label rule (:func:`neural3d.extraction.measure.class_area_m2`) gives a
+The vertex-label rule (:func:`neural3d.extraction.facade_groups.class_area_m2`) gives a
 triangle's area to the classes of its corners' argmax labels. A semantic field
 that cannot follow an opening's edge to better than its grid cell (about 0.2 m
 on a 45 m tower) blurs the window's indicator; the argmax of a blurred

@@ -12,14 +12,17 @@ zero contours (``skimage.measure.find_contours``, linear interpolation) become
 rings, and nesting is resolved by even-odd (symmetric difference), which keeps
 courtyards as holes. Pieces and holes smaller than ``min_area_m2`` are dropped.
 
-A hole is a courtyard only if it is open to the sky. Nothing constrains a
-trained field inside a building (no camera sees it), so it may leave empty
-pockets there, which the planes cut as holes (one L-shape lost 21 of its
-121 m² to five of them). Each hole is probed along vertical lines from the
-highest plane to the box top, at up to :data:`HOLE_PROBE_LINES` points of a
-``cell_m`` grid at least a cell inside it, one sample per ``cell_m``: a line meets a surface
-where some sample is within half a cell of it (|SDF| <= cell_m / 2, or inside).
-A hole where most lines meet a surface is roofed over and is filled.
+The roofed-hole fill (``roofed_hole_fill``): a hole is a courtyard only if it is
+open to the sky. Nothing constrains a trained field inside a building (no camera
+sees it), so it may leave empty pockets there, which the planes cut as holes
+(one L-shape lost 21 of its 121 m² to five of them). Each hole is probed along
+vertical lines from the highest plane to the box top, at up to
+:data:`HOLE_PROBE_LINES` points of a ``cell_m`` grid at least a cell inside it,
+one sample per ``cell_m``: a line meets a surface where some sample is within
+half a cell of it (|SDF| <= cell_m / 2, or inside). A hole where most lines
+meet a surface is roofed over and is filled. This assumes no building has a
+roofed hole in its footprint at 1-4 m: a covered passage or a glass-roofed
+courtyard would be filled (footprint biased high).
 """
 
 from __future__ import annotations
@@ -28,24 +31,15 @@ from collections.abc import Sequence
 
 import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
-from tqdm import tqdm
 
-from neural3d.extraction.meshing import SdfFn, check_box
-from neural3d.field.chunks import DEFAULT_CHUNK_POINTS, evaluate_in_chunks
+from neural3d.extraction.meshing import SdfFn, check_box, evaluate_points
 
 MAX_FOOTPRINT_CELLS = 4096  # per axis: 16.8 M samples
 HOLE_PROBE_LINES = 64  # vertical lines per footprint hole (open to the sky or roofed over)
 
 
-def sample_sdf_plane(
-    sdf_fn: SdfFn,
-    xs: np.ndarray,
-    ys: np.ndarray,
-    height_m: float,
-    *,
-    chunk_points: int = DEFAULT_CHUNK_POINTS,
-    progress: bool = False,
-) -> np.ndarray:
+def sample_sdf_plane(sdf_fn: SdfFn, xs: np.ndarray, ys: np.ndarray, height_m: float
+                     ) -> np.ndarray:
     """SDF on the grid ``xs × ys`` at ``z = height_m``.
 
     Returns
@@ -54,10 +48,7 @@ def sample_sdf_plane(
     """
     xx, yy = np.meshgrid(xs, ys, indexing="ij")
     pts = np.stack([xx.ravel(), yy.ravel(), np.full(xx.size, float(height_m))], axis=1)
-    values = np.concatenate([
-        evaluate_in_chunks(sdf_fn, pts[s:s + chunk_points], chunk_points)
-        for s in tqdm(range(0, len(pts), chunk_points), desc="footprint", disable=not progress)
-    ])
+    values = evaluate_points(sdf_fn, pts)
     if not np.isfinite(values).all():
         raise ValueError("the SDF returned NaN or inf on the footprint plane; check the field")
     return values.reshape(xx.shape).astype(np.float64)
@@ -71,7 +62,7 @@ def footprint_from_sdf(
     heights_m: Sequence[float],
     cell_m: float,
     min_area_m2: float,
-    chunk_points: int = DEFAULT_CHUNK_POINTS,
+    roofed_hole_fill: bool = True,
 ) -> Polygon | MultiPolygon:
     """Footprint polygon (world x/y metres) where the SDF averaged over planes is negative.
 
@@ -88,6 +79,8 @@ def footprint_from_sdf(
         Grid spacing in m.
     min_area_m2 : float
         Pieces and holes smaller than this are dropped (slivers, noise).
+    roofed_hole_fill : bool
+        Fill the holes a surface roofs over (:func:`fill_roofed_holes`).
 
     Returns
     -------
@@ -116,8 +109,7 @@ def footprint_from_sdf(
         raise ValueError(f"footprint grid of {tuple(counts)} cells is too large (at most "
                          f"{MAX_FOOTPRINT_CELLS} per axis); raise cell_m")
     xs, ys = (lo[i] + cell_m * np.arange(max(counts[i], 2)) for i in range(2))
-    values = np.mean([sample_sdf_plane(sdf_fn, xs, ys, h, chunk_points=chunk_points)
-                      for h in heights], axis=0)
+    values = np.mean([sample_sdf_plane(sdf_fn, xs, ys, h) for h in heights], axis=0)
     where = f"z = {heights[0]} m" if len(heights) == 1 else f"z = {heights} m"
     if values.min() >= 0:
         raise ValueError(f"the plane(s) {where} miss the building (the SDF is positive "
@@ -126,13 +118,15 @@ def footprint_from_sdf(
         raise ValueError(f"the plane(s) {where} lie wholly inside the surface; the box is "
                          "too small or the field is degenerate")
     polygon = _polygon_from_grid(values, xs[0], ys[0], cell_m, min_area_m2)
+    if not roofed_hole_fill:
+        return polygon
     return fill_roofed_holes(polygon, sdf_fn, z_from_m=max(heights), z_to_m=float(hi[2]),
-                             cell_m=cell_m, chunk_points=chunk_points)
+                             cell_m=cell_m)
 
 
 def fill_roofed_holes(
     polygon: Polygon | MultiPolygon, sdf_fn: SdfFn, *, z_from_m: float, z_to_m: float,
-    cell_m: float, chunk_points: int = DEFAULT_CHUNK_POINTS,
+    cell_m: float,
 ) -> Polygon | MultiPolygon:
     """``polygon`` (world x/y m) with every hole that a surface roofs over filled.
 
@@ -149,13 +143,12 @@ def fill_roofed_holes(
     pieces = []
     for piece in getattr(polygon, "geoms", [polygon]):
         holes = [ring for ring in piece.interiors
-                 if not _roofed(Polygon(ring), sdf_fn, zs, cell_m, chunk_points)]
+                 if not _roofed(Polygon(ring), sdf_fn, zs, cell_m)]
         pieces.append(Polygon(piece.exterior, holes))
     return pieces[0] if len(pieces) == 1 else MultiPolygon(pieces)
 
 
-def _roofed(hole: Polygon, sdf_fn: SdfFn, zs: np.ndarray, cell_m: float,
-            chunk_points: int) -> bool:
+def _roofed(hole: Polygon, sdf_fn: SdfFn, zs: np.ndarray, cell_m: float) -> bool:
     from shapely import contains_xy
 
     x0, y0, x1, y1 = hole.bounds
@@ -170,7 +163,7 @@ def _roofed(hole: Polygon, sdf_fn: SdfFn, zs: np.ndarray, cell_m: float,
     xy = xy[np.linspace(0, len(xy) - 1, min(len(xy), HOLE_PROBE_LINES)).round().astype(int)]
     pts = np.concatenate([np.repeat(xy, len(zs), axis=0),
                           np.tile(zs, len(xy))[:, None]], axis=1)  # (L * Z, 3)
-    sdf = evaluate_in_chunks(sdf_fn, pts, chunk_points).reshape(len(xy), len(zs))
+    sdf = evaluate_points(sdf_fn, pts).reshape(len(xy), len(zs))
     return bool(((sdf <= cell_m / 2).any(axis=1)).mean() > 0.5)
 
 

@@ -1,29 +1,79 @@
-"""How a semantic mesh is measured: :class:`MeasureConfig` (see
-:mod:`neural3d.extraction.measure`)."""
+"""How a semantic mesh is measured: which stages run (:class:`MeasureStages`) and their
+settings (:class:`MeasureConfig`); the stages are :mod:`neural3d.extraction.measure_stages`."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal
+from dataclasses import dataclass, field, fields, replace
 
 from dataset.rendering.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
+
+# stage -> the stage whose output it reads (a stage runs only with the one it needs)
+STAGE_NEEDS = {
+    "plane_projection": "grouping",
+    "plane_probe": "plane_projection",
+    "front_seen_readd": "plane_probe",
+    "occluded_fill": "plane_probe",
+    "concave_corner_fill": "plane_probe",
+}
+
+
+@dataclass(frozen=True)
+class MeasureStages:
+    """One switch per stage of :func:`neural3d.extraction.measure.measure_semantic_mesh`, in
+    the order they run; each stage's assumptions are in
+    :mod:`neural3d.extraction.measure_stages`. All on is neural3d's measurement; all off
+    is the paper's count (every triangle's classes by its vertices' labels)."""
+
+    probability_split: bool = True
+    visibility_cull: bool = True
+    grouping: bool = True
+    plane_projection: bool = True
+    plane_probe: bool = True
+    front_seen_readd: bool = True
+    occluded_fill: bool = True
+    concave_corner_fill: bool = True
+
+    def __post_init__(self) -> None:
+        for stage, needed in STAGE_NEEDS.items():
+            if getattr(self, stage) and not getattr(self, needed):
+                raise ValueError(f"stage {stage} needs stage {needed}: switch {needed} on or "
+                                 f"{stage} off")
+
+    def without(self, *stages: str) -> MeasureStages:
+        """These stages off, and every stage that needs one of them.
+
+        Raises
+        ------
+        ValueError
+            If a name is not a stage (the names are this class's fields).
+        """
+        names = {f.name for f in fields(self)}
+        unknown = sorted(set(stages) - names)
+        if unknown:
+            raise ValueError(f"unknown measurement stage(s) {unknown}; stages: "
+                             f"{', '.join(f.name for f in fields(self))}")
+        off = set(stages)
+        while True:
+            more = {s for s, needed in STAGE_NEEDS.items() if needed in off} - off
+            if not more:
+                return replace(self, **{s: False for s in off})
+            off |= more
 
 
 @dataclass(frozen=True)
 class MeasureConfig:
-    """How facade areas are counted and facades grouped (see the module docstring).
+    """Which stages run and the settings each reads (grouped below by stage).
 
-    ``count="projected"`` counts facade triangles by their shadow on the nearest
-    facade plane (robust to the wavy walls, recesses and undersides of a neural
-    field's mesh); ``count="all"`` sums the classes over every triangle (the
-    paper); ``count="grouped"`` only over triangles in a kept facade group.
-
-    Only faces seen from outside count (``visibility_rays_per_sample`` > 0): a
-    trained field may close surfaces inside the building (a blob behind the
-    windows, the sides of a tunnel at a door), which no facade holds.
+    The assumptions behind each setting and where it biases are documented with
+    its stage in :mod:`neural3d.extraction.measure_stages`.
     """
 
-    count: Literal["projected", "all", "grouped"] = "projected"
+    stages: MeasureStages = field(default_factory=MeasureStages)
+    # visibility_cull (dataset.rendering.visibility): 4 points x this many rays per face
+    visibility_rays_per_sample: int = 4
+    min_escape_fraction: float = MIN_ESCAPE_FRACTION
+    ray_offset_m: float = RAY_OFFSET_M
+    # grouping (neural3d.extraction.facade_groups)
     facade_max_tilt_deg: float = 30.0
     azimuth_bin_deg: float = 1.0
     azimuth_smoothing_deg: float = 3.0
@@ -31,26 +81,20 @@ class MeasureConfig:
     plane_gap_m: float = 1.0
     min_facade_area_m2: float = 1.0
     min_facade_area_fraction: float = 0.02
-    # a trained wall wanders ~0.2 m; 0.4 m keeps a 5 m radius curve's segments within 2 %
+    # plane_projection (neural3d.extraction.facade_planes); plane_slab_m and
+    # plane_max_angle_deg also decide what the plane probe meets.
+    # A trained wall wanders ~0.2 m; 0.4 m keeps a 5 m radius curve's segments within 2 %.
     plane_slab_m: float = 0.4
     plane_max_angle_deg: float = 60.0
     curve_strip_m: float = 1.0  # wider than a window recess, narrow enough to follow a curve
-    # facade hidden behind balconies (neural3d.extraction.occluded_facade), "projected" only:
-    # grid cell (0 = off) and how far in front of a plane occluders are looked for
+    # plane_probe, occluded_fill, concave_corner_fill (neural3d.extraction.occluded_facade,
+    # neural3d.extraction.concave_corners): the probe grid's cell, how far in front of a
+    # plane occluders are looked for, the longest run continued to a concave corner
     occlusion_cell_m: float = 0.1
     occluder_reach_m: float = 3.0
-    # a concave corner the field filled (neural3d.extraction.concave_corners), with occlusion:
-    # the longest run of a wall's row continued to the corner line (0 = off)
     corner_max_gap_m: float = 1.5
-    # seen from outside (dataset.rendering.visibility): 4 points x this many rays per face;
-    # 0 = every face counts
-    visibility_rays_per_sample: int = 4
-    min_escape_fraction: float = MIN_ESCAPE_FRACTION
-    ray_offset_m: float = RAY_OFFSET_M
 
     def __post_init__(self) -> None:
-        if self.count not in ("projected", "all", "grouped"):
-            raise ValueError(f"count must be 'projected', 'all' or 'grouped', got {self.count!r}")
         if not 0.0 < self.plane_max_angle_deg < 90.0:
             raise ValueError(f"plane_max_angle_deg must be in (0, 90), got "
                              f"{self.plane_max_angle_deg}")
@@ -63,16 +107,18 @@ class MeasureConfig:
             raise ValueError("min_facade_separation_deg must be in (0, 180], got "
                              f"{self.min_facade_separation_deg}")
         for name in ("azimuth_smoothing_deg", "plane_gap_m", "min_facade_area_m2",
-                     "min_facade_area_fraction", "plane_slab_m", "corner_max_gap_m"):
+                     "min_facade_area_fraction", "plane_slab_m"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
-        if self.visibility_rays_per_sample < 0 or not 0 < self.min_escape_fraction <= 1:
-            raise ValueError(f"visibility_rays_per_sample must be >= 0 and min_escape_fraction "
+        if self.visibility_rays_per_sample < 1 or not 0 < self.min_escape_fraction <= 1:
+            raise ValueError(f"visibility_rays_per_sample must be >= 1 and min_escape_fraction "
                              f"in (0, 1], got {self.visibility_rays_per_sample}, "
                              f"{self.min_escape_fraction}")
-        if self.occlusion_cell_m < 0 or not self.occluder_reach_m > self.plane_slab_m:
-            raise ValueError(f"occlusion_cell_m must be >= 0 and occluder_reach_m > plane_slab_m, "
+        if self.occlusion_cell_m <= 0 or not self.occluder_reach_m > self.plane_slab_m:
+            raise ValueError(f"occlusion_cell_m must be > 0 and occluder_reach_m > plane_slab_m, "
                              f"got {self.occlusion_cell_m}, {self.occluder_reach_m}")
+        if not self.corner_max_gap_m > 0:
+            raise ValueError(f"corner_max_gap_m must be > 0, got {self.corner_max_gap_m}")
         if not self.curve_strip_m > 0:
             raise ValueError(f"curve_strip_m must be > 0, got {self.curve_strip_m}")
 

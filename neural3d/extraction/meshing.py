@@ -8,8 +8,10 @@ The core works on plain NumPy callables so it does not depend on torch:
 - ``LabelFn``: (N, 3) world metres -> (N,) int class ids (:mod:`dataset.core.classes`);
 - ``ColorFn``: (N, 3) world metres, (N, 3) unit view directions -> (N, 3) float in [0, 1].
 
-The grid is evaluated slab by slab into one float32 volume (512³ = 0.5 GB), so
-memory is bounded by the volume plus ``chunk_points`` evaluations at a time.
+The grid is evaluated in groups of x slabs of about ``chunk_points`` points into
+one float32 volume (512³ = 0.5 GB), so memory is bounded by the volume plus one
+group. The callables take whole arrays: a trained field splits its own calls
+(:mod:`neural3d.field.chunks`).
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ from tqdm import tqdm
 from dataset.core.classes import NUM_CLASSES
 from dataset.core.mesh import triangle_areas_m2
 from dataset.core.semantic_ply import check_mesh_arrays, check_points_m
-from neural3d.field.chunks import DEFAULT_CHUNK_POINTS, evaluate_in_chunks
+from neural3d.field.chunks import DEFAULT_CHUNK_POINTS
 
 SdfFn = Callable[[np.ndarray], np.ndarray]
 LabelFn = Callable[[np.ndarray], np.ndarray]
@@ -104,7 +106,8 @@ def sample_sdf_grid(
     chunk_points: int = DEFAULT_CHUNK_POINTS,
     progress: bool = False,
 ) -> np.ndarray:
-    """Evaluate ``sdf_fn`` on the grid ``xs × ys × zs``, slab by slab along x.
+    """Evaluate ``sdf_fn`` on the grid ``xs × ys × zs``, x slabs grouped into calls of at
+    most ``chunk_points`` points (one slab when a slab holds more).
 
     Returns
     -------
@@ -120,7 +123,7 @@ def sample_sdf_grid(
     starts = range(0, nx, slabs_per_chunk)
     for start in tqdm(starts, desc="sdf grid", unit="slab", disable=not progress):
         stop = min(start + slabs_per_chunk, nx)
-        values = evaluate_in_chunks(sdf_fn, _slab_points(xs[start:stop], plane_yz), chunk_points)
+        values = evaluate_points(sdf_fn, _slab_points(xs[start:stop], plane_yz))
         volume[start:stop] = values.reshape(stop - start, ny, nz)
     if not np.isfinite(volume).all():
         raise ValueError("the SDF returned NaN or inf on the grid; check the field")
@@ -149,7 +152,7 @@ def extract_mesh(
     resolution, voxel_size_m
         Samples along the longest box side, or the voxel size in m (exactly one).
     chunk_points : int
-        Most points passed to ``sdf_fn`` in one call.
+        Points per call of ``sdf_fn``: whole x slabs up to this many (one slab if more).
     min_component_area_fraction : float in [0, 1)
         Connected pieces with less than this fraction of the total area are removed
         (floaters); 0 keeps everything.
@@ -227,9 +230,7 @@ def vertex_normals(vertices_m: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return np.divide(n, length, out=np.zeros_like(n), where=length > 0)
 
 
-def label_vertices(
-    vertices_m: np.ndarray, label_fn: LabelFn, *, chunk_points: int = DEFAULT_CHUNK_POINTS
-) -> np.ndarray:
+def label_vertices(vertices_m: np.ndarray, label_fn: LabelFn) -> np.ndarray:
     """Class id of every vertex from ``label_fn`` (e.g. the argmax of a semantic head).
 
     Returns
@@ -237,7 +238,7 @@ def label_vertices(
     (V,) uint8 class ids.
     """
     vertices_m = check_points_m(vertices_m)
-    labels = evaluate_in_chunks(label_fn, vertices_m, chunk_points, out_shape=())
+    labels = evaluate_points(label_fn, vertices_m)
     if len(labels) and (labels.min() < 0 or labels.max() >= NUM_CLASSES):
         raise ValueError(f"label_fn returned class ids outside 0..{NUM_CLASSES - 1}")
     return labels.astype(np.uint8)
@@ -247,8 +248,6 @@ def color_vertices(
     vertices_m: np.ndarray,
     faces: np.ndarray,
     color_fn: ColorFn,
-    *,
-    chunk_points: int = DEFAULT_CHUNK_POINTS,
 ) -> np.ndarray:
     """Colour of every vertex seen head-on: ``color_fn(points, view_dirs = -normal)``.
 
@@ -258,9 +257,24 @@ def color_vertices(
     """
     normals = vertex_normals(vertices_m, faces)
     both = np.concatenate([vertices_m, -normals], axis=1)
-    rgb = evaluate_in_chunks(lambda p: color_fn(p[:, :3], p[:, 3:]), both, chunk_points,
-                        out_shape=(3,))
+    rgb = evaluate_points(lambda p: color_fn(p[:, :3], p[:, 3:]), both, out_shape=(3,))
     return np.round(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
+
+
+def evaluate_points(fn: Callable[[np.ndarray], np.ndarray], points: np.ndarray,
+                    out_shape: tuple[int, ...] = ()) -> np.ndarray:
+    """``fn`` on (N, D) points in one call: (N, *out_shape).
+
+    Raises
+    ------
+    ValueError
+        If ``fn`` returns another shape.
+    """
+    out = np.asarray(fn(points))
+    if out.shape != (len(points), *out_shape):
+        raise ValueError(f"the callable returned shape {out.shape} for {len(points)} points; "
+                         f"expected {(len(points), *out_shape)}")
+    return out
 
 
 def _marching_cubes(

@@ -5,8 +5,8 @@ door behind them from every camera but a few steep ones, so a trained field
 closes or dents that space and its mesh has no facade there; the truth counts
 the facade behind an occluder (an auditor needs the door's whole area). And the
 wall at the back of a balcony, between railing and slab, lets few of the
-hemisphere rays of :mod:`neural3d.extraction.measure`'s visibility test escape,
-so that test drops it although a camera in front sees it.
+hemisphere rays of the visibility cull (:mod:`neural3d.extraction.measure_stages`)
+escape, so that test drops it although a camera in front sees it.
 
 So, on each facade plane of :class:`neural3d.extraction.facade_planes.FacadePlanes`,
 a grid of ``occlusion_cell_m`` squares over the u/z extent of the plane's
@@ -71,7 +71,7 @@ def probe_planes(
     ----------
     raycaster : over the measured mesh (world metres)
     class_area_m2 : (F, NUM_CLASSES) each face's area shared among classes
-        (:func:`neural3d.extraction.measure.class_area_m2`)
+        (:func:`neural3d.extraction.facade_groups.class_area_m2`)
     planes : the mesh's facade planes (``weight`` (F, K): which faces count on plane k)
     cell_m, slab_m : grid cell and the planes' slab half-width, metres
     max_angle_deg : how far a face's normal may turn from the plane's and face it
@@ -111,33 +111,44 @@ def front_seen_faces(probes: list[PlaneProbe | None], face_count: int) -> np.nda
     return seen
 
 
+def seen_cell_labels(class_area_m2: np.ndarray,
+                     probes: list[PlaneProbe | None]) -> list[np.ndarray | None]:
+    """Per plane, the (U, Z) class of each cell of its probe grid: the seen triangle's
+    largest facade class, -1 for a cell not seen; None where ``probes`` has none.
+
+    ``class_area_m2`` (F, NUM_CLASSES): the faces' class areas the probes were made with.
+    """
+    facade_label = np.array(FACADE_IDS)[np.argmax(class_area_m2[:, list(FACADE_IDS)], axis=1)]
+    return [None if probe is None else
+            np.where(probe.seen, facade_label[np.maximum(probe.face, 0)], -1).reshape(probe.shape)
+            for probe in probes]
+
+
 def occluded_facade_labels(
     raycaster: Raycaster, class_area_m2: np.ndarray, planes: FacadePlanes,
-    probes: list[PlaneProbe | None], *, slab_m: float, reach_m: float,
+    probes: list[PlaneProbe | None], seen_labels: list[np.ndarray | None], *,
+    slab_m: float, reach_m: float,
 ) -> list[np.ndarray | None]:
-    """Per plane, the (U, Z) class each cell of its probe grid takes: the seen triangle's
-    largest facade class, or, for facade hidden behind an occluder, the class it is
-    filled with (module docstring); -1 for a cell neither seen nor filled. None where
-    ``probes`` has none.
+    """Per plane, the (U, Z) class each cell of its probe grid takes: its class in
+    ``seen_labels`` (:func:`seen_cell_labels`), or, for facade hidden behind an occluder,
+    the class it is filled with (module docstring); -1 for a cell neither seen nor
+    filled. None where ``probes`` has none.
 
     ``probes`` from :func:`probe_planes` on the same planes; ``reach_m``: how far in
     front of a plane occluders are looked for.
     """
     occluder = ~np.isin(np.argmax(class_area_m2, axis=1), FACADE_IDS)  # (F,)
-    facade_label = np.array(FACADE_IDS)[np.argmax(class_area_m2[:, list(FACADE_IDS)], axis=1)]
     out: list[np.ndarray | None] = []
-    for k, probe in enumerate(probes):
+    for k, (probe, seen) in enumerate(zip(probes, seen_labels)):
         if probe is None:
             out.append(None)
             continue
         normal, _ = plane_frame(planes.azimuth_deg[k])
-        label = np.where(probe.seen, facade_label[np.maximum(probe.face, 0)], -1)
         face, t = raycaster.first_hit(probe.points_m + reach_m * normal,
                                       np.broadcast_to(-normal, probe.points_m.shape))
         hit = face >= 0
         occluded = np.zeros(len(face), dtype=bool)
         occluded[hit] = occluder[face[hit]] & (t[hit] < reach_m - slab_m)
-        seen = label.reshape(probe.shape)
         filled = _fill_columns(seen, occluded.reshape(probe.shape))
         out.append(np.where(seen >= 0, seen, filled))
     return out

@@ -21,8 +21,9 @@ from neural3d.field.normalisation import Normalisation
 class TrainedField:
     """A :class:`SemanticSDF` with its normalisation; every input and output in world metres.
 
-    Queries run without gradients, in chunks, on the field's device; inputs are
-    moved there and outputs stay there.
+    Queries run without gradients, in calls of at most ``chunk_points`` points (the one
+    place a field is evaluated in chunks, :mod:`neural3d.field.chunks`), on the field's
+    device; inputs are moved there and outputs stay there.
     """
 
     def __init__(self, field: SemanticSDF, normalisation: Normalisation, *, scene_dir: Path,
@@ -39,22 +40,25 @@ class TrainedField:
     def device(self) -> torch.device:
         return self.field.log_inv_s.device
 
-    def sdf_m(self, points_world_m: Tensor) -> Tensor:
+    def sdf_m(self, points_world_m: Tensor, *,
+              chunk_points: int = DEFAULT_CHUNK_POINTS) -> Tensor:
         """"(N, 3)" world points (m) -> "(N,)" signed distance in metres, positive outside."""
         x = self._unit(points_world_m)
         with torch.no_grad():
-            out = [self.field.sdf(c) for c in x.split(DEFAULT_CHUNK_POINTS)]
+            out = [self.field.sdf(c) for c in x.split(_checked(chunk_points))]
         return _cat(out, x) * self.normalisation.scale_m
 
-    def semantic_logits(self, points_world_m: Tensor) -> Tensor:
+    def semantic_logits(self, points_world_m: Tensor, *,
+                        chunk_points: int = DEFAULT_CHUNK_POINTS) -> Tensor:
         """"(N, 3)" world points (m) -> "(N, C)" class logits (view-independent)."""
         x = self._unit(points_world_m)
         with torch.no_grad():
             out = [self.field.semantic_logits(self.field.sdf_net(c)[1])
-                   for c in x.split(DEFAULT_CHUNK_POINTS)]
+                   for c in x.split(_checked(chunk_points))]
         return _cat(out, x, self.field.num_classes)
 
-    def rgb(self, points_world_m: Tensor, view_dirs_world: Tensor) -> Tensor:
+    def rgb(self, points_world_m: Tensor, view_dirs_world: Tensor, *,
+            chunk_points: int = DEFAULT_CHUNK_POINTS) -> Tensor:
         """"(N, 3)" points (m) and "(N, 3)" view directions -> "(N, 3)" colour in [0, 1]."""
         x = self._unit(points_world_m)
         d = view_dirs_world.to(device=self.device, dtype=torch.float32)
@@ -63,7 +67,7 @@ class TrainedField:
                              f"{tuple(d.shape)}")
         d = d / d.norm(dim=-1, keepdim=True).clamp(min=1e-12)
         out = []
-        for xc, dc in zip(x.split(DEFAULT_CHUNK_POINTS), d.split(DEFAULT_CHUNK_POINTS)):
+        for xc, dc in zip(x.split(_checked(chunk_points)), d.split(chunk_points)):
             _, feature, grad = self.field.sdf_feature_gradient(xc, create_graph=False)
             with torch.no_grad():
                 out.append(self.field.colour(xc, dc, grad, feature))
@@ -75,6 +79,12 @@ class TrainedField:
             raise ValueError(f"points_world_m must be (N, 3), got {tuple(p.shape)}")
         p = p.to(device=self.device, dtype=torch.float64)
         return self.normalisation.unit_from_world(p).to(torch.float32)
+
+
+def _checked(chunk_points: int) -> int:
+    if chunk_points < 1:
+        raise ValueError(f"chunk_points must be >= 1, got {chunk_points}")
+    return int(chunk_points)
 
 
 def _cat(chunks: list[Tensor], x: Tensor, *trailing: int) -> Tensor:

@@ -15,8 +15,8 @@ from torch import Tensor
 
 from dataset.core.camera import Intrinsics, rays_world
 from dataset.core.classes import SemanticClass
+from dataset.core.method_input import MethodInput
 from dataset.core.protocols import Split
-from dataset.core.scene_record import Scene
 from dataset.scenes.images import read_rgb
 from dataset.scenes.scene_validation import read_frame_depth_m, read_frame_labels
 from neural3d.field.normalisation import Normalisation
@@ -58,14 +58,14 @@ class Pixels:
         return len(self.labels)
 
 
-def background_class(scene: Scene) -> int:
+def background_class(scene: MethodInput) -> int:
     """Our background class id: :func:`dataset.scenes.scene_validation.read_frame_labels` gives
     every frame's labels in the project's ids (:data:`dataset.core.classes.CLASS_NAMES`), whatever
     the scene holds."""
     return int(SemanticClass.BACKGROUND)
 
 
-def load_frames(scene: Scene, split: Split, *, image_scale: float = 1.0,
+def load_frames(scene: MethodInput, split: Split, *, image_scale: float = 1.0,
                 with_depth: bool = False) -> list[LoadedFrame]:
     """Read the frames of ``split``, resized by ``image_scale``.
 
