@@ -23,10 +23,12 @@ three checks. Measuring time is not training time.
 from __future__ import annotations
 
 import argparse
+import copy
 import json
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -37,7 +39,7 @@ import torch  # noqa: E402
 
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.device import resolve_device  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
 from neural3d.field.trained import TrainedField, build_field  # noqa: E402
 from neural3d.train import train  # noqa: E402
@@ -53,32 +55,42 @@ WWR_TARGET_PCT = 5.0
 IOU_TARGET = 0.96
 
 
+def training_steps(scene_dir: Path, config: TrainConfig, device: torch.device
+                   ) -> Callable[[int], None]:
+    """``step(i)``: training step ``i`` (``train_step``, weight averaging included) of a fresh
+    field on ``scene_dir``'s train frames, as ``neural3d.train`` runs it; synchronised on CUDA.
+    """
+    scene = read_method_input(scene_dir)  # never the truth, as in neural3d.train
+    bg = background_class(scene)
+    frames = load_frames(scene, "train", image_scale=config.image_scale)
+    norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
+    px = frames_to_pixels(frames, norm, device)
+    with torch.random.fork_rng(devices=[]):
+        torch.manual_seed(config.seed)
+        field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
+    optimizer, scheduler = make_optimizer(field, config)
+    average = copy.deepcopy(field).requires_grad_(False) if config.ema_decay > 0 else None
+    lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
+    hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
+    gen = torch.Generator(device=device).manual_seed(config.seed)
+    occupancy = make_occupancy(config, lo, hi)
+
+    def step(i: int) -> None:
+        train_step(field, optimizer, scheduler, px, lo, hi, config, step=i,
+                   background_class=bg, generator=gen, occupancy=occupancy, average=average)
+        if device.type == "cuda":
+            torch.cuda.synchronize(device)
+
+    return step
+
+
 def iterations_per_second(scene_dir: Path, config: TrainConfig, device: torch.device,
                           steps: int, warmup: int = 1) -> tuple[float, float]:
     """(iterations per wall second, per process CPU second) of the training step.
 
     ``warmup`` untimed steps first; the occupancy grid (if any) starts at step 0.
     """
-    config = replace(config, occupancy_start=0)
-    scene = read_scene(scene_dir)
-    bg = background_class(scene)
-    frames = load_frames(scene, "train", image_scale=config.image_scale)
-    norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
-    px = frames_to_pixels(frames, norm, device)
-    torch.manual_seed(0)
-    field = build_field(config.model, len(scene.semantic_classes), norm).to(device)
-    optimizer, scheduler = make_optimizer(field, config)
-    lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
-    hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
-    gen = torch.Generator(device=device).manual_seed(0)
-    occupancy = make_occupancy(config, lo, hi)
-
-    def step(i: int) -> None:
-        train_step(field, optimizer, scheduler, px, lo, hi, config, step=i,
-                   background_class=bg, generator=gen, occupancy=occupancy)
-        if device.type == "cuda":
-            torch.cuda.synchronize(device)
-
+    step = training_steps(scene_dir, replace(config, occupancy_start=0), device)
     warmup = max(warmup, 1)  # allocator, first calls, the grid's first refreshes
     for i in range(warmup):
         step(i)

@@ -54,7 +54,7 @@ from neural3d.training.run_folder import (
     start_run_folder,
     write_log,
 )
-from neural3d.training.step import make_occupancy, make_optimizer, train_step, update_ema
+from neural3d.training.step import make_occupancy, make_optimizer, train_step
 
 LOG_EVERY = 10  # steps between log.csv rows
 
@@ -151,9 +151,7 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
             tic = time.perf_counter()
             result = train_step(field, optimizer, scheduler, pixels, box_min, box_max, config,
                                 step=step, background_class=bg, generator=gen,
-                                occupancy=occupancy)
-            if average is not None:
-                update_ema(average, field, config.ema_decay)
+                                occupancy=occupancy, average=average)
             step += 1
             train_s += time.perf_counter() - tic
             bar.update(1)

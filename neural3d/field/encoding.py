@@ -8,7 +8,9 @@ gather. On CPU the gather reads each row as one wide element through
 5x faster than advanced indexing and ``index_add``); the eight trilinear
 weights are built from per-axis factors without broadcasting, so no backward
 pass has to reduce over broadcast axes (docs/decisions.md, "grid encoding
-speed"; figures in docs/measurements/neural3d-training.md).
+speed"; figures in docs/measurements/neural3d-training.md). Corner indices are int32 and
+hashed with a mask (the table is a power of two), about 2x cheaper to compute than int64
+with a modulo.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 import torch
 from torch import Tensor, nn
 from torch.autograd.function import once_differentiable
+from torch.profiler import record_function
 
 _PRIMES = (1, 2654435761, 805459861)  # instant-ngp's spatial hash
 
@@ -37,7 +40,7 @@ _ROW_DTYPES = {(torch.float32, 1): torch.float32, (torch.float32, 2): torch.floa
 
 
 def gather_rows(table: Tensor, index: Tensor) -> Tensor:
-    """``table[index]`` for a "(T, F)" table and an int64 index of any shape -> "(*index, F)".
+    """``table[index]`` for a "(T, F)" table and an integer index of any shape -> "(*index, F)".
 
     A float32 row of 1, 2 or 4 features is read as one 4-, 8- or 16-byte element,
     so ``index_select`` copies one element per row (no autograd).
@@ -59,7 +62,7 @@ def scatter_add_rows(grad: Tensor, index: Tensor, rows: int) -> Tensor:
     on CPU is about 3x faster than ``index_add_`` on the rows.
     """
     flat = index.reshape(-1)
-    per_feature = grad.reshape(len(flat), -1).unbind(1)
+    per_feature = grad.reshape(len(flat), grad.shape[-1]).unbind(1)  # no -1: N may be 0
     sums = [torch.bincount(flat, weights=g, minlength=rows) for g in per_feature]
     return torch.stack(sums, 1).to(grad.dtype)
 
@@ -101,7 +104,7 @@ class GridEncoding(nn.Module):
         extent = hi - lo
         growth = math.exp((math.log(max_res) - math.log(min_res)) / max(levels - 1, 1))
         table = 2**log2_table
-        res, offsets, hashed, sizes = [], [], [], []
+        res, offsets, hashed = [], [], []
         total = 0
         for level in range(levels):
             r = min_res * growth**level
@@ -111,25 +114,32 @@ class GridEncoding(nn.Module):
             res.append(r_axes)
             offsets.append(total)
             hashed.append(n_vertices > table)
-            sizes.append(size)
             total += size
         self.levels, self.features = levels, features
         self.out_dim = levels * features
+        if total >= 2**31:
+            raise ValueError(f"grid table of {total} rows does not fit int32 indices; lower "
+                             "log2_table or levels")
         # Buffers derived from the config are not saved: a checkpoint holds learnt weights.
+        # Indices are int32 (about 2x faster to compute than int64 on CPU); only the hashed
+        # levels' products with the primes need int64.
+        i32 = torch.int32
         self.register_buffer("box_min", torch.tensor(lo, dtype=torch.float32), persistent=False)
         self.register_buffer("box_size", torch.tensor(extent, dtype=torch.float32),
                              persistent=False)
-        self.register_buffer("res", torch.tensor(np.stack(res)), persistent=False)  # (L, 3) int64
-        self.register_buffer("offsets", torch.tensor(offsets), persistent=False)  # (L,)
+        self.register_buffer("res", torch.tensor(np.stack(res), dtype=i32),
+                             persistent=False)  # (L, 3)
+        self.register_buffer("offsets", torch.tensor(offsets, dtype=i32), persistent=False)
         self.register_buffer("hashed", torch.tensor(hashed), persistent=False)  # (L,) bool
-        self.register_buffer("sizes", torch.tensor(sizes), persistent=False)  # (L,)
+        self.hash_mask = table - 1  # hashed levels fill the table, a power of two
         self.n_dense = int(sum(not h for h in hashed))
         if any(hashed[: self.n_dense]):
             raise AssertionError("dense levels must come first")  # resolution grows per level
         strides = [[1, r[0] + 1, (r[0] + 1) * (r[1] + 1)] for r in res]
-        self.register_buffer("strides", torch.tensor(strides), persistent=False)  # (L, 3)
-        self.register_buffer("primes", torch.tensor(_PRIMES), persistent=False)
-        self.register_buffer("two", torch.arange(2), persistent=False)
+        self.register_buffer("strides", torch.tensor(strides, dtype=i32),
+                             persistent=False)  # (L, 3)
+        self.register_buffer("primes", torch.tensor(_PRIMES), persistent=False)  # int64
+        self.register_buffer("two", torch.arange(2, dtype=i32), persistent=False)
         self.register_buffer("level_mask", torch.ones(levels), persistent=False)
         self.table = nn.Parameter(torch.empty(total, features).uniform_(-1e-4, 1e-4))
 
@@ -139,18 +149,23 @@ class GridEncoding(nn.Module):
         self.level_mask.copy_(ramp)
 
     def forward(self, x: Tensor) -> Tensor:
+        index, frac = self._cells(x)
+        weights = _trilinear_weights(frac)  # (N, L, 8)
+        with record_function("neural3d.encoding gather"):
+            values = _FlatGather.apply(self.table, index)  # (N, L, 8, F)
+        feats = torch.stack([(weights * values[..., f]).sum(-1)
+                             for f in range(self.features)], -1)  # (N, L, F)
+        return (feats * self.level_mask[:, None]).reshape(len(x), self.out_dim)
+
+    def _cells(self, x: Tensor) -> tuple[Tensor, Tensor]:
+        """Table rows "(N, L, 8)" (int32) of each point's cell corners, corner
+        c = 4 bx + 2 by + bz, and the point's position in its cell "(N, L, 3)" in [0, 1],
+        differentiable in ``x``; points outside the box are clamped to it."""
         if x.ndim != 2 or x.shape[1] != 3:
             raise ValueError(f"GridEncoding expects (N, 3) points, got {tuple(x.shape)}")
-        n = len(x)
         u = ((x - self.box_min) / self.box_size).clamp(0, 1)  # (N, 3) in the unit cube
         pos = u[:, None, :] * self.res  # (N, L, 3)
-        i0 = pos.detach().floor().long().clamp(max=self.res - 1)
-        frac = pos - i0  # (N, L, 3), differentiable in x
-        # Corner c = 4 bx + 2 by + bz of each cell, for weights and indices alike.
-        fx, fy, fz = frac.unbind(-1)  # (N, L) each
-        gx, gy, gz = 1 - fx, 1 - fy, 1 - fz
-        xy = (gx * gy, gx * fy, fx * gy, fx * fy)
-        weights = torch.stack([a * b for a in xy for b in (gz, fz)], -1)  # (N, L, 8)
+        i0 = pos.detach().floor().int().clamp(max=self.res - 1)
         ic = i0[..., None] + self.two  # (N, L, 3, 2)
         nd = self.n_dense
         parts = []
@@ -159,14 +174,19 @@ class GridEncoding(nn.Module):
             parts.append(a[:, :, 0, :, None, None] + a[:, :, 1, None, :, None]
                          + a[:, :, 2, None, None, :])
         if nd < self.levels:
-            a = ic[:, nd:] * self.primes[:, None]
+            a = ic[:, nd:].long() * self.primes[:, None]
             h = a[:, :, 0, :, None, None] ^ a[:, :, 1, None, :, None] ^ a[:, :, 2, None, None, :]
-            parts.append(h % self.sizes[nd:, None, None, None])
+            parts.append((h & self.hash_mask).int())
         index = torch.cat(parts, 1) + self.offsets[:, None, None, None]  # (N, L, 2, 2, 2)
-        values = _FlatGather.apply(self.table, index.reshape(n, self.levels, 8))  # (N, L, 8, F)
-        feats = torch.stack([(weights * values[..., f]).sum(-1)
-                             for f in range(self.features)], -1)  # (N, L, F)
-        return (feats * self.level_mask[:, None]).reshape(n, self.out_dim)
+        return index.reshape(len(x), self.levels, 8), pos - i0
+
+
+def _trilinear_weights(frac: Tensor) -> Tensor:
+    """"(N, L, 3)" position in the cell -> "(N, L, 8)" weight of corner c = 4 bx + 2 by + bz."""
+    fx, fy, fz = frac.unbind(-1)
+    gx, gy, gz = 1 - fx, 1 - fy, 1 - fz
+    xy = (gx * gy, gx * fy, fx * gy, fx * fy)
+    return torch.stack([a * b for a in xy for b in (gz, fz)], -1)
 
 
 class PositionalInput(nn.Module):
@@ -181,7 +201,8 @@ class PositionalInput(nn.Module):
         """No schedule: the encoding is fixed."""
 
     def forward(self, x: Tensor) -> Tensor:
-        return positional_encoding(x, self.frequencies)
+        with record_function("neural3d.encoding"):
+            return positional_encoding(x, self.frequencies)
 
 
 class GridInput(nn.Module):
@@ -204,5 +225,6 @@ class GridInput(nn.Module):
         self.grid.set_active_levels(self.start_levels + ramp * (levels - self.start_levels))
 
     def forward(self, x: Tensor) -> Tensor:
-        return torch.cat([x, self.grid(x)], dim=-1)
+        with record_function("neural3d.encoding"):
+            return torch.cat([x, self.grid(x)], dim=-1)
 

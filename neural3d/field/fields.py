@@ -19,6 +19,7 @@ import numpy as np
 import torch
 from torch import Tensor, nn
 from torch.nn.utils.parametrizations import weight_norm
+from torch.profiler import record_function
 
 from neural3d.config import FieldConfig
 from neural3d.field.encoding import GridEncoding, GridInput, PositionalInput, positional_encoding
@@ -139,7 +140,9 @@ class SDFNetwork(nn.Module):
         last.bias[0] = a * last.bias[0] + b
 
     def forward(self, x: Tensor) -> tuple[Tensor, Tensor]:
-        h = self.mlp(self.encoding(x))
+        features = self.encoding(x)
+        with record_function("neural3d.sdf mlp"):
+            h = self.mlp(features)
         return h[:, 0], h[:, 1:]
 
 
@@ -201,23 +204,28 @@ class SemanticSDF(nn.Module):
             h = self.config.fd_step
             offsets = torch.eye(3, dtype=x.dtype, device=x.device) * h
             xs = torch.cat([x[:, None] + offsets, x[:, None] - offsets], 1).reshape(-1, 3)
-            s = self.sdf_net(xs)[0].reshape(len(x), 2, 3)
+            with record_function("neural3d.sdf gradient"):
+                s = self.sdf_net(xs)[0].reshape(len(x), 2, 3)
             return sdf, feature, (s[:, 0] - s[:, 1]) / (2 * h)
         with torch.enable_grad():
             x = x.detach().requires_grad_(True) if not x.requires_grad else x
             sdf, feature = self.sdf_net(x)
-            (grad,) = torch.autograd.grad(sdf, x, torch.ones_like(sdf), create_graph=create_graph)
+            with record_function("neural3d.sdf gradient"):
+                (grad,) = torch.autograd.grad(sdf, x, torch.ones_like(sdf),
+                                              create_graph=create_graph)
         if not create_graph:
             sdf, feature = sdf.detach(), feature.detach()
         return sdf, feature, grad
 
     def colour(self, x: Tensor, view_dirs: Tensor, normals: Tensor, feature: Tensor) -> Tensor:
         """RGB "(N, 3)" in [0, 1]; ``view_dirs`` are unit ray directions "(N, 3)"."""
-        return self.colour_net(x, view_dirs, normals, feature)
+        with record_function("neural3d.colour"):
+            return self.colour_net(x, view_dirs, normals, feature)
 
     def semantic_logits(self, feature: Tensor) -> Tensor:
         """Feature "(N, F)" -> class logits "(N, C)"."""
-        return self.semantic_net(feature)
+        with record_function("neural3d.semantic head"):
+            return self.semantic_net(feature)
 
     def background_rgb(self, view_dirs: Tensor) -> Tensor:
         """RGB "(R, 3)" of the environment at infinity seen along unit directions "(R, 3)"."""

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import torch
 from torch import Tensor
+from torch.profiler import record_function
 
 from neural3d.config import TrainConfig
 from neural3d.field.fields import SemanticSDF
@@ -54,37 +55,58 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
     Rays that miss the box see only the environment. ``occupancy``: clip each ray
     to its occupied cells first (empty-space skipping).
     """
-    near, far, hit = ray_box_near_far(origins, dirs, box_min, box_max)
+    with record_function("neural3d.sampling"):
+        near, far, hit = ray_box_near_far(origins, dirs, box_min, box_max)
     if occupancy is not None:
-        near, far, hit = occupancy.clip_rays(origins, dirs, near, far, hit)
-    idx = torch.nonzero(hit).squeeze(1)
-    o, d = origins[idx], dirs[idx]
-    t = uniform_samples(near[idx], far[idx], config.samples_uniform, perturb=training,
-                        generator=generator)
-    t, _ = neus_upsample(field.sdf, o, d, t, config.samples_importance, config.upsample_steps)
-    t_mid = (t[:, 1:] + t[:, :-1]) * 0.5
-    lengths = t[:, 1:] - t[:, :-1]
-    n_rays, n_samples = t_mid.shape
-    pts = (o[:, None, :] + d[:, None, :] * t_mid[..., None]).reshape(-1, 3)
-    dirs_s = d[:, None, :].expand(n_rays, n_samples, 3).reshape(-1, 3)
+        with record_function("neural3d.occupancy"):
+            near, far, hit = occupancy.clip_rays(origins, dirs, near, far, hit)
+    with record_function("neural3d.sampling"):
+        idx = torch.nonzero(hit).squeeze(1)
+        o, d = origins[idx], dirs[idx]
+        t = uniform_samples(near[idx], far[idx], config.samples_uniform, perturb=training,
+                            generator=generator)
+        t, _ = neus_upsample(field.sdf, o, d, t, config.samples_importance,
+                             config.upsample_steps)
+        t_mid = (t[:, 1:] + t[:, :-1]) * 0.5
+        lengths = t[:, 1:] - t[:, :-1]
+        n_rays, n_samples = t_mid.shape
+        pts = (o[:, None, :] + d[:, None, :] * t_mid[..., None]).reshape(-1, 3)
+        dirs_s = d[:, None, :].expand(n_rays, n_samples, 3).reshape(-1, 3)
     sdf, feature, grad = field.sdf_feature_gradient(pts, create_graph=training)
-    rgb = field.colour(pts, dirs_s, grad, feature).reshape(n_rays, n_samples, 3)
-    logits = field.semantic_logits(feature).reshape(n_rays, n_samples, field.num_classes)
-    cos = (grad * dirs_s).sum(-1).reshape(n_rays, n_samples)
-    alpha = neus_alpha(sdf.reshape(n_rays, n_samples), cos, lengths, field.inv_s(),
-                       cos_anneal_ratio=cos_anneal_ratio(config, step))
-    weights = weights_from_alpha(alpha)
+    with record_function("neural3d.compositing"):
+        cos = (grad * dirs_s).sum(-1).reshape(n_rays, n_samples)
+        alpha = neus_alpha(sdf.reshape(n_rays, n_samples), cos, lengths, field.inv_s(),
+                           cos_anneal_ratio=cos_anneal_ratio(config, step))
+        weights = weights_from_alpha(alpha)
+        kept = None
+        if config.min_sample_weight > 0:  # light samples are dropped (as if transparent)
+            heavy = weights.detach() > config.min_sample_weight
+            weights = weights * heavy
+            kept = torch.nonzero(heavy.reshape(-1)).squeeze(1)
+    rgb = _at_samples(field.colour, kept, pts, dirs_s, grad, feature)
+    logits = _at_samples(field.semantic_logits, kept, feature)
+    with record_function("neural3d.compositing"):
+        rgb = rgb.reshape(n_rays, n_samples, 3)
+        logits = logits.reshape(n_rays, n_samples, field.num_classes)
+        background = field.background_rgb(dirs)
+        num_classes = field.num_classes
+        sem_full = torch.zeros(len(origins), num_classes, dtype=dirs.dtype, device=dirs.device)
+        sem_full[:, background_class] = 1.0
+        zeros = torch.zeros(len(origins), dtype=dirs.dtype, device=dirs.device)
+        return RenderOutput(
+            rgb=background.index_copy(0, idx, render_rgb(weights, rgb, background[idx])),
+            semantics=sem_full.index_copy(0, idx, render_semantics(weights, logits,
+                                                                   background_class)),
+            depth=zeros.index_copy(0, idx, render_depth(weights, t_mid)),
+            accumulation=zeros.index_copy(0, idx, render_accumulation(weights)),
+            sdf_gradients=grad,
+        )
 
-    background = field.background_rgb(dirs)
-    num_classes = field.num_classes
-    sem_full = torch.zeros(len(origins), num_classes, dtype=dirs.dtype, device=dirs.device)
-    sem_full[:, background_class] = 1.0
-    zeros = torch.zeros(len(origins), dtype=dirs.dtype, device=dirs.device)
-    return RenderOutput(
-        rgb=background.index_copy(0, idx, render_rgb(weights, rgb, background[idx])),
-        semantics=sem_full.index_copy(0, idx, render_semantics(weights, logits,
-                                                               background_class)),
-        depth=zeros.index_copy(0, idx, render_depth(weights, t_mid)),
-        accumulation=zeros.index_copy(0, idx, render_accumulation(weights)),
-        sdf_gradients=grad,
-    )
+
+def _at_samples(head, kept: Tensor | None, *inputs: Tensor) -> Tensor:
+    """``head(*inputs)`` "(M, D)" at every sample, evaluated only at the ``kept`` rows (zeros
+    elsewhere, where the weight is 0); every row when ``kept`` is None."""
+    if kept is None:
+        return head(*inputs)
+    out = head(*(x[kept] for x in inputs))
+    return out.new_zeros(len(inputs[0]), out.shape[1]).index_copy(0, kept, out)

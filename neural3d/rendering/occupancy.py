@@ -19,7 +19,9 @@ import torch
 import torch.nn.functional as F
 from torch import Tensor
 
-from neural3d.field.chunks import DEFAULT_CHUNK_POINTS
+# Points per SDF call of a refresh: small enough to stay in the CPU's caches (a refresh of
+# 130k cells took 0.41 s of CPU in chunks of 2^14 points, 0.71-0.78 s in chunks of 2^16).
+REFRESH_CHUNK_POINTS = 2**14
 
 
 class OccupancyGrid:
@@ -55,7 +57,7 @@ class OccupancyGrid:
         ``sdf_fn``: "(N, 3)" -> "(N,)" in normalised units; ``margin`` in the same units.
         """
         centres = self.cell_centres()
-        sdf = torch.cat([sdf_fn(c) for c in centres.split(DEFAULT_CHUNK_POINTS)])
+        sdf = torch.cat([sdf_fn(c) for c in centres.split(REFRESH_CHUNK_POINTS)])
         near_surface = (sdf.abs() < 0.5 * math.sqrt(3) * self.cell + margin).reshape(self.shape)
         grown = F.max_pool3d(near_surface[None, None].float(), 3, stride=1, padding=1)
         self.occupied = grown[0, 0] > 0

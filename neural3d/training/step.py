@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from functools import partial
 
 import torch
+from torch.profiler import record_function
 
 from neural3d.config import TrainConfig
 from neural3d.field.fields import SemanticSDF
@@ -57,8 +58,7 @@ class StepResult:
 @torch.no_grad()
 def update_ema(average: torch.nn.Module, field: torch.nn.Module, decay: float) -> None:
     """``average`` <- decay * average + (1 - decay) * field (parameters); buffers copied."""
-    for a, p in zip(average.parameters(), field.parameters()):
-        a.lerp_(p, 1.0 - decay)
+    torch._foreach_lerp_(list(average.parameters()), list(field.parameters()), 1.0 - decay)
     for a, b in zip(average.buffers(), field.buffers()):
         a.copy_(b)
 
@@ -75,29 +75,43 @@ def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
                scheduler: torch.optim.lr_scheduler.LRScheduler | None, pixels: Pixels,
                box_min: torch.Tensor, box_max: torch.Tensor, config: TrainConfig, *,
                step: int, background_class: int, generator: torch.Generator,
-               occupancy: OccupancyGrid | None = None) -> StepResult:
+               occupancy: OccupancyGrid | None = None,
+               average: torch.nn.Module | None = None) -> StepResult:
     """One optimisation step at ``step`` (the only training step; the bench calls it too).
 
     Draws ``config.rays_per_batch`` pixels with ``generator``, renders them, takes
     the weighted loss and one optimizer (and scheduler, if given) step. With an
     ``occupancy`` grid, rays skip empty space; the grid is refreshed from the SDF
-    at ``occupancy_start`` and every ``occupancy_every`` steps after.
+    at ``occupancy_start`` and every ``occupancy_every`` steps after. With an
+    ``average`` (a copy of ``field``), it follows ``field`` by ``config.ema_decay``.
+    Each part runs under a ``neural3d.<part>`` profiler label (bench/neural3d_profile.py).
     """
     field.set_step(step)
     if occupancy is not None and step >= config.occupancy_start and (
             step - config.occupancy_start) % config.occupancy_every == 0:
-        occupancy.update_from_sdf(field.sdf, margin=config.occupancy_margin_cells * occupancy.cell)
-    idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
-                        device=pixels.rgb.device)
-    out = render_rays(field, pixels.origins[idx], pixels.dirs[idx], box_min, box_max, config,
-                      step=step, training=True, background_class=background_class,
-                      generator=generator, occupancy=occupancy)
-    depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
-    loss, parts = total_loss(out, pixels.rgb[idx], pixels.labels[idx], config,
-                             background_class=background_class, depth_t=depth_t)
-    optimizer.zero_grad(set_to_none=True)
-    loss.backward()
-    optimizer.step()
-    if scheduler is not None:
-        scheduler.step()
+        with record_function("neural3d.occupancy"):
+            occupancy.update_from_sdf(field.sdf,
+                                      margin=config.occupancy_margin_cells * occupancy.cell)
+    with record_function("neural3d.rays"):
+        idx = torch.randint(len(pixels), (config.rays_per_batch,), generator=generator,
+                            device=pixels.rgb.device)
+        origins, dirs, rgb, labels = (pixels.origins[idx], pixels.dirs[idx], pixels.rgb[idx],
+                                      pixels.labels[idx])
+        depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
+    out = render_rays(field, origins, dirs, box_min, box_max, config, step=step, training=True,
+                      background_class=background_class, generator=generator,
+                      occupancy=occupancy)
+    with record_function("neural3d.losses"):
+        loss, parts = total_loss(out, rgb, labels, config, background_class=background_class,
+                                 depth_t=depth_t)
+    with record_function("neural3d.backward"):
+        optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+    with record_function("neural3d.optimiser"):
+        optimizer.step()
+        if scheduler is not None:
+            scheduler.step()
+    if average is not None:
+        with record_function("neural3d.weight averaging"):
+            update_ema(average, field, config.ema_decay)
     return StepResult(float(loss.detach()), parts, idx, out)

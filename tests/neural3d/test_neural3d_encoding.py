@@ -82,6 +82,15 @@ def test_row_gather_and_its_scatter_match_indexing(features):
     assert got.dtype == table.dtype and torch.allclose(got, expected, atol=1e-5)
 
 
+def test_no_points_give_a_zero_gradient():
+    """A batch whose rays all miss the occupied cells evaluates the grid at no point."""
+    enc = grid()
+    out = enc(torch.zeros(0, 3))
+    assert out.shape == (0, enc.out_dim)
+    (g,) = torch.autograd.grad(out.sum(), enc.table, allow_unused=False)
+    assert g.shape == enc.table.shape and not g.any()
+
+
 def test_coarse_to_fine_masks_levels():
     enc = grid()
     with torch.no_grad():
@@ -89,6 +98,15 @@ def test_coarse_to_fine_masks_levels():
     enc.set_active_levels(1.5)
     out = enc(torch.zeros(1, 3))[0]
     assert torch.allclose(out, torch.tensor([1.0, 1.0, 0.5, 0.5, 0.0, 0.0]))
+
+
+def test_indices_are_int32_and_a_table_beyond_them_is_refused():
+    enc = grid(levels=3, min_res=4, max_res=64, log2_table=12)  # dense, dense, hashed
+    index, _ = enc._cells(torch.rand(50, 3) * 2 - 1)
+    assert index.dtype == torch.int32
+    assert 0 <= int(index.min()) and int(index.max()) < len(enc.table)
+    with pytest.raises(ValueError, match="int32"):
+        grid(levels=2, min_res=2048, max_res=2048, log2_table=30)  # 2 x 2^30 rows
 
 
 def test_bad_inputs():

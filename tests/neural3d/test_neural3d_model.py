@@ -34,3 +34,38 @@ def test_cos_anneal_ratio():
     c = preset_config("paper")
     assert cos_anneal_ratio(c, 0) == 0.0 and cos_anneal_ratio(c, c.cos_anneal_steps) == 1.0
     assert cos_anneal_ratio(preset_config("fast"), 0) == 1.0
+
+
+def test_light_samples_skip_the_heads_and_barely_change_the_render():
+    """min_sample_weight drops samples of weight <= w: the colour and semantic heads see
+    only the others, and every rendered quantity moves by at most the dropped weight."""
+    from dataclasses import replace
+
+    config = preset_config("tiny")
+    torch.manual_seed(0)
+    field = SemanticSDF(config.model, 4, np.full(3, -1.0), np.full(3, 1.0))  # sphere r = 0.5
+    lo, hi = torch.full((3,), -1.0), torch.full((3,), 1.0)
+    gen = torch.Generator().manual_seed(0)
+    dirs = torch.randn(64, 3, generator=gen)
+    dirs = dirs / dirs.norm(dim=1, keepdim=True)
+    origins = -2.5 * dirs + 0.3 * torch.randn(64, 3, generator=gen)  # some miss the sphere
+    seen = []
+    field.colour_net.register_forward_hook(lambda m, args, out: seen.append(len(out)))
+
+    def render(threshold):
+        seen.clear()
+        out = render_rays(field, origins, dirs, lo, hi, replace(config,
+                          min_sample_weight=threshold), step=0, training=False,
+                          background_class=0)
+        return out, seen[0]
+
+    full, n_all = render(0.0)
+    light, n_kept = render(1e-3)
+    samples = config.samples_uniform + config.samples_importance - 1
+    assert n_all == len(full.sdf_gradients) and 0 < n_kept < n_all
+    bound = samples * 1e-3  # at most every sample of a ray dropped at the threshold
+    assert (full.accumulation - light.accumulation).abs().max() <= bound
+    assert (full.accumulation >= light.accumulation).all()
+    assert (full.rgb - light.rgb).abs().max() <= bound
+    assert (full.semantics - light.semantics).abs().max() <= bound
+    assert torch.allclose(light.semantics.sum(1), torch.ones(64), atol=1e-5)
