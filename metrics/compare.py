@@ -19,7 +19,6 @@ segmenter's masks beside the exact ones), :func:`robustness_study`
 
 from __future__ import annotations
 
-import shutil
 import sys
 import time
 from collections.abc import Mapping, Sequence
@@ -27,7 +26,7 @@ from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
 
-from dataset.core.atomic import atomic_directory, write_json_atomic, write_text_atomic
+from dataset.core.atomic import write_json_atomic, write_text_atomic
 from dataset.core.cli_errors import check_output_folder, run_cli
 from dataset.core.method import available_methods
 from dataset.core.results import code_version
@@ -36,6 +35,12 @@ from dataset.executors.ray_tasks import RayConfig
 from metrics.aggregate import GroupSummary, aggregate_by_family
 from metrics.benchmark_cache import ensure_benchmark
 from metrics.compare_args import CompareRequest, compare_request, parse_compare_args
+from metrics.compare_outputs import (
+    keep_pipeline_images,
+    write_footprints,
+    write_html_report,
+    write_plots,
+)
 from metrics.degraded import degraded_run, with_degradation
 from metrics.errors import (
     NO_TRUTH_FAMILY,
@@ -47,7 +52,6 @@ from metrics.errors import (
 from metrics.errors import failed_building as failed_row
 from metrics.executors import make_executor
 from metrics.explain import explain, methods_provenance_text, recorded_steps, run_timings
-from metrics.html_report import write_report
 from metrics.mesh_pointers import write_mesh_pointers
 from metrics.methods import list_methods, method_specs
 from metrics.orientation_errors import (
@@ -55,7 +59,6 @@ from metrics.orientation_errors import (
     orientation_table,
     summarise_orientations,
 )
-from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.predicted_masks import compare_on_predicted_masks, masks_segmenter
 from metrics.report import (
     per_building_table,
@@ -150,15 +153,15 @@ def compare(
     for table in (per_building_table(rows), per_facade_table(facade_rows),
                   timing_table(run_timings(outcomes))):
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
-    _write_plots(groups, rows, out_dir / PLOTS_FOLDER)
-    _write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
+    write_plots(groups, rows, out_dir / PLOTS_FOLDER)
+    write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
     for spec in specs:
         write_mesh_pointers(scene_dirs, spec, out_dir)
     with_images = [s for s in specs if s.debug_images is not None]
     if allow_run and with_images:
-        _keep_pipeline_images(scene_dirs, with_images[0], out_dir / PIPELINE_FOLDER)
+        keep_pipeline_images(scene_dirs, with_images[0], out_dir / PIPELINE_FOLDER)
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
-    _write_html_report(out_dir)
+    write_html_report(out_dir)
     return comparison
 
 
@@ -233,68 +236,6 @@ def _provenance(
             for o in outcomes
         ],
     }
-
-
-def _write_html_report(out_dir: Path) -> None:
-    """``report.html`` from what was just written; a failure warns, the comparison stands."""
-    try:
-        write_report(out_dir)
-    except Exception as exc:  # the page is a view of the outputs, not one of them
-        print(f"warning: report.html not written: {type(exc).__name__}: {exc}", file=sys.stderr)
-
-
-def _write_plots(groups, rows, folder: Path) -> None:
-    """Replace ``folder`` with this comparison's plots (a skipped plot leaves no stale file)."""
-    with atomic_directory(folder) as tmp:
-        for plot, data, stem in (
-            (plot_errors_by_family, groups, "errors_by_family"),
-            (plot_wwr_scatter, rows, "wwr_scatter"),
-            (plot_iou_per_building, rows, "iou_per_building"),
-        ):
-            try:
-                plot(data, tmp / stem)
-            except ValueError as exc:
-                print(f"plot {stem} skipped: {exc}", file=sys.stderr)
-
-
-def _write_footprints(outcomes: Sequence[Outcome], folder: Path) -> None:
-    """Replace ``folder`` with the estimated footprints of this comparison's results."""
-    with atomic_directory(folder) as tmp:
-        for o in outcomes:
-            if o.result is not None and o.result.footprint is not None:
-                write_json_atomic(tmp / f"{o.scene}__{o.method}__{o.protocol}.geojson",
-                                  o.result.footprint)
-
-
-def _keep_pipeline_images(scene_dirs: Sequence[Path], spec: MethodSpec, folder: Path) -> None:
-    """Keep ``spec``'s debug images (2D-SS's) of one facade (the first view of the first
-    scene's facade 1)."""
-    if folder.is_dir() and any(folder.glob("*.png")):
-        return
-    assert spec.debug_images is not None
-    protocol = spec.protocols[0]
-    for scene_dir in scene_dirs:
-        if not (scene_dir / "transforms.json").is_file():
-            continue
-        tmp = folder.with_name(f".{folder.name}.tmp")
-        shutil.rmtree(tmp, ignore_errors=True)
-        try:
-            spec.debug_images(scene_dir, protocol, tmp)
-        except Exception as exc:  # the figure is optional; the comparison is not
-            print(f"{spec.name} pipeline images skipped: {type(exc).__name__}: {exc}",
-                  file=sys.stderr)
-            shutil.rmtree(tmp, ignore_errors=True)
-            return
-        images = sorted(tmp.glob("*.png"))
-        if images:
-            # One facade: the images sharing the first file's <scene>__<protocol>__f<id>__v<k> stem.
-            stem = images[0].name.rsplit("__", 1)[0]
-            folder.mkdir(parents=True, exist_ok=True)
-            for image in images:
-                if image.name.startswith(stem + "__"):
-                    shutil.copy2(image, folder / image.name)
-        shutil.rmtree(tmp, ignore_errors=True)
-        return
 
 
 def main(argv: Sequence[str] | None = None) -> int:
