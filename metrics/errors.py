@@ -22,6 +22,7 @@ from shapely.ops import unary_union
 from dataset.core.footprint import geojson_to_polygon
 from dataset.core.results import MethodResult
 from dataset.core.truth import BuildingTruth
+from metrics.covered_facades import facade_distance_limit_m, over_truth_facades
 from metrics.facade_match import has_facade_geometry, match_facades
 
 Status = Literal["ok", "failed"]
@@ -158,17 +159,21 @@ def building_errors(
     """Errors of one result against its building's truth (``None``: estimates only).
 
     ``stale``: the result was kept although made by other code or settings.
-    A result without a WWR counts as failed, with its warnings as the reason.
-    A footprint that cannot be compared (malformed GeoJSON) gives IoU ``None``
+    Against a truth that counts only some walls (CityGML's covered facades) a result's
+    own facades count only where they lie on those (:mod:`metrics.covered_facades`),
+    and the reason says so. A result without a WWR counts as failed, with its warnings
+    as the reason. A footprint that cannot be compared (malformed GeoJSON) gives IoU ``None``
     and a reason, but does not fail the WWR figures.
     """
     family = truth.type if truth is not None else NO_TRUTH_FAMILY
     marks = result_marks(result, stale=stale)
+    result, covered_note = over_truth_facades(result, truth) if truth is not None else (
+        result, "")
     if result.wwr is None or not math.isfinite(result.wwr):
         reason = "; ".join(result.warnings) or "the method produced no WWR"
         return replace(failed_building(result.scene, family, result.method, result.protocol,
                                        reason), steps=result.steps, marks=marks, seed=result.seed)
-    reasons: list[str] = []
+    reasons: list[str] = [covered_note] if covered_note else []
     iou = None
     if result.footprint is not None and truth is not None:
         try:
@@ -230,9 +235,10 @@ def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[Fa
     Under the ideal and multi protocols the result's facade ids are the truth's
     (each view carries its facade id). Other results (a mesh's facades) number their
     own facades; when every estimate carries ``normal`` and ``centre_m`` they
-    are matched to the truth's facades by :func:`metrics.facade_match.match_facades`,
-    and each estimate that faces no truth facade gives a failed row with
-    facade id ``LEFT_OUT_FACADE_ID`` (0) and the reason. Otherwise: no rows.
+    are matched to the truth's facades by :func:`metrics.facade_match.match_facades`
+    (only those on a covered facade where the truth counts only some walls), and each
+    estimate that faces no truth facade gives a failed row with facade id
+    ``LEFT_OUT_FACADE_ID`` (0) and the reason. Otherwise: no rows.
     """
     if truth is None:
         return ()
@@ -241,7 +247,8 @@ def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[Fa
         estimates, left_out = result.facades, ()
     elif has_facade_geometry(result.facades):
         try:
-            match = match_facades(result.facades, truth)
+            match = match_facades(result.facades, truth,
+                                  max_distance_m=facade_distance_limit_m(truth))
         except ValueError as exc:  # a malformed result file fails its facades, not the run
             return (FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=str(exc)),)
         estimates, left_out = match.facades, match.left_out

@@ -31,6 +31,7 @@ from dataset.core.orientation import (
 from dataset.core.results import FacadeEstimate, MethodResult
 from dataset.core.truth import BuildingTruth
 from dataset.core.wwr import wwr_from_areas
+from metrics.covered_facades import facade_distance_limit_m
 from metrics.facade_match import has_facade_geometry, match_facades
 
 TRUTH_METHOD = "truth"  # the method name of the truth's own rows
@@ -170,7 +171,8 @@ def estimates_by_truth_facade(result: MethodResult, truth: BuildingTruth
     """The result's figures on the truth's facade ids (one per truth facade, in its order).
 
     Results on ideal / multi views carry the truth's ids; results that locate
-    their own facades are matched (:func:`metrics.facade_match.match_facades`).
+    their own facades are matched (:func:`metrics.facade_match.match_facades`; only those on
+    a covered facade where the truth counts only some walls, :mod:`metrics.covered_facades`).
     ``None`` when the result has no per-facade figures, neither applies or the match fails.
     """
     if not result.facades:
@@ -183,7 +185,8 @@ def estimates_by_truth_facade(result: MethodResult, truth: BuildingTruth
     if not has_facade_geometry(result.facades):
         return None
     try:
-        return match_facades(result.facades, truth).facades
+        return match_facades(result.facades, truth,
+                             max_distance_m=facade_distance_limit_m(truth)).facades
     except ValueError:
         return None
 

@@ -18,7 +18,9 @@ truth's ``building.json``:
    by :class:`dataset.core.wwr.ClassAreas`, widths add and the largest
    height stays;
 4. a truth facade no estimate reaches is reported missing; an estimate whose
-   normal agrees with no truth facade is left out with a reason.
+   normal agrees with no truth facade is left out with a reason, and so is one farther
+   from its facade than ``max_distance_m`` where a limit is given (a truth that counts
+   only some walls, :mod:`metrics.covered_facades`).
 
 Only the method's figures are used; the truth decides which facade they belong to.
 """
@@ -57,8 +59,14 @@ def has_facade_geometry(estimates: Sequence[FacadeEstimate]) -> bool:
         e.normal is not None and e.centre_m is not None for e in estimates)
 
 
-def match_facades(estimates: Sequence[FacadeEstimate], truth: BuildingTruth) -> FacadeMatch:
+def match_facades(estimates: Sequence[FacadeEstimate], truth: BuildingTruth, *,
+                  max_distance_m: float | None = None) -> FacadeMatch:
     """Give ``estimates`` the truth's facade ids (see the module docstring).
+
+    ``max_distance_m``: an estimate whose centre lies farther than this from its facade's
+    nearest wall outline is left out (a wall the truth does not count;
+    :mod:`metrics.covered_facades`); ``None``: no limit. A facade without outlines cannot
+    be checked: estimates on it are kept.
 
     Raises
     ------
@@ -72,10 +80,15 @@ def match_facades(estimates: Sequence[FacadeEstimate], truth: BuildingTruth) -> 
         if est.normal is None or est.centre_m is None:
             raise ValueError(f"estimated facade {est.id} has no normal or centre_m; only "
                              "results that locate their facades can be matched to the truth")
-        owner = _owner(est, truth, outlines)
+        located = facade_owner(est, truth, outlines)
+        owner = None if located is None else located[0]
         if owner is None:
             left_out.append((est.id, f"estimated facade {est.id} faces no truth facade "
                                      f"(normal within {MAX_NORMAL_ANGLE_DEG:g} degrees)"))
+        elif max_distance_m is not None and np.isfinite(located[1]) and located[1] > max_distance_m:
+            left_out.append((est.id, f"estimated facade {est.id} lies {located[1]:.1f} m from "
+                                     f"truth facade {owner}, farther than {max_distance_m:g} m: "
+                                     "a wall the truth does not count"))
         else:
             owners.setdefault(owner, []).append(est)
     facades = tuple(
@@ -104,7 +117,18 @@ def distance_to_outline_m(point_m: Sequence[float], outline_m: Sequence[Sequence
     return float(np.hypot(p @ normal, in_plane_m))
 
 
-def _owner(est: FacadeEstimate, truth: BuildingTruth, outlines: dict) -> int | None:
+def facade_owner(est: FacadeEstimate, truth: BuildingTruth,
+                 outlines: dict | None = None) -> tuple[int, float] | None:
+    """The truth facade ``est`` goes to (rules 1-2 of the module docstring) and the distance
+    in m from its centre to that facade's nearest wall outline (``inf`` for a facade without
+    outlines); ``None`` where no truth facade's normal agrees with its own.
+
+    Raises
+    ------
+    ValueError
+        If the estimate's normal has no length.
+    """
+    outlines = truth.facade_outlines_m if outlines is None else outlines
     n = np.asarray(est.normal, dtype=np.float64)
     if not np.linalg.norm(n) > 0:
         raise ValueError(f"estimated facade {est.id} has a zero normal")
@@ -123,7 +147,7 @@ def _owner(est: FacadeEstimate, truth: BuildingTruth, outlines: dict) -> int | N
         for distance, cos in candidates:
             if cos > min_cos and (best is None or (distance, -cos, t.id) < best):
                 best = (distance, -cos, t.id)
-    return None if best is None else best[2]
+    return None if best is None else (best[2], best[0])
 
 
 def _merge(parts: list[FacadeEstimate], facade_id: int) -> FacadeEstimate:

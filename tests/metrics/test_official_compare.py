@@ -9,8 +9,8 @@ import contextlib
 import io
 
 import pytest
-from test_blenderproc import write_blenderproc_output
-from test_buildnet3d import FIXTURE
+from blenderproc_output import write_blenderproc_output
+from paths import FIXTURES
 
 from dataset.generate import main as generate_main
 
@@ -23,7 +23,7 @@ def test_metrics_compare_runs_every_method_on_imported_scenes(box_building, tmp_
     write_blenderproc_output(tmp_path / "bproc" / "house", box_building, "generator")
     data = tmp_path / "scenes"
     with contextlib.redirect_stdout(io.StringIO()):
-        for src in (FIXTURE / "images/building0", tmp_path / "bproc"):
+        for src in (FIXTURES / "buildnet3d_generator" / "images/building0", tmp_path / "bproc"):
             assert generate_main(["--buildnet3d", str(src), "--out", str(data)]) == 0
     argv = ["--data", str(data), "--methods", "2D-S,2D-SS,neural3d", "--views", "ideal",
             "--neural3d-preset", "tiny", "--neural3d-steps", "30",
