@@ -52,11 +52,12 @@ def over_truth_facades(result: MethodResult, truth: BuildingTruth) -> tuple[Meth
 
     The note names how many estimated facades counted and how many were left out.
     """
-    if (counts_every_wall(truth) or result.facade_identity == "truth_id"
+    limit_m = facade_distance_limit_m(truth)
+    if (limit_m is None or result.facade_identity == "truth_id"
             or result.wwr is None or not has_facade_geometry(result.facades)):
         return result, ""
     try:
-        match = match_facades(result.facades, truth, max_distance_m=ON_FACADE_MAX_DISTANCE_M)
+        match = match_facades(result.facades, truth, max_distance_m=limit_m)
     except ValueError as exc:  # a malformed result file (a zero normal) fails its figures
         return replace(result, wwr=None, window_area_m2=None, facade_area_m2=None,
                        warnings=(*result.warnings, str(exc))), ""
