@@ -259,7 +259,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return mode(
             request, f"python -m metrics.compare {argv_text}".strip(),
             allow_run=not args.no_run, reuse_stale=args.reuse_stale,
-            execute=make_executor(args.executor, RayConfig(address=args.ray_address)))
+            execute=make_executor(
+                args.executor, RayConfig(address=args.ray_address, num_cpus=args.cpus),
+                cpus=args.cpus))
 
     return run_cli("metrics.compare", body, debug=args.debug, interrupted=(
         "interrupted: finished results are kept; run again to continue"))

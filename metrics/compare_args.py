@@ -115,7 +115,11 @@ def parse_compare_args(argv: Sequence[str] | None,
                         help="print the full provenance record of one scene's result(s) of one "
                         "method, and whether the current code would reuse it; runs nothing")
     add_executor_arguments(parser, "missing runs one after the other in this process",
-                           "building, method and views")
+                           "building, method and views", processes_help=(
+                               "the light methods here, then each heavy run (a training) in "
+                               "a process of its own, as many at once as fit in --cpus and the "
+                               "GPU; what a run reserves is its method's: a training the cores "
+                               "of its threads, or its share of the GPU with --device cuda"))
     add_debug_flag(parser)
     add_method_options(parser, methods)
     return parser.parse_args(argv)
@@ -145,7 +149,7 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
     ``<data>-compare``; with ``--explain SCENE METHOD`` the one method is METHOD. The
     methods' configs take their short-run values in the built-in default run and the
     robustness study, and are checked for running here unless nothing runs in this
-    process (``--no-run``, ``--explain``, a Ray executor: its GPUs are on its nodes).
+    machine (``--no-run``, ``--explain``, a Ray executor: its GPUs are on its nodes).
 
     Raises
     ------
@@ -155,7 +159,7 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
     default = DefaultBenchmark() if args.data is None else None
     data = (default.folder if default is not None else args.data).resolve()
     names = (args.explain[1],) if args.explain else _listed(args.methods)
-    runs_here = args.executor == "local" and not (args.no_run or args.explain)
+    runs_here = args.executor in ("local", "processes") and not (args.no_run or args.explain)
     configs = method_configs(args, methods, names, runs_here=runs_here,
                              short_run=default is not None or args.robustness)
     return CompareRequest(

@@ -1,10 +1,17 @@
-"""Where the comparison's missing runs execute: here (``local``) or on a Ray cluster (``ray``).
+"""Where the comparison's missing runs execute: here, one after the other (``local``); here,
+several at once in processes of their own (``processes``); or on a Ray cluster (``ray``).
 
-Both are :data:`metrics.runner.Execute` functions: they take the jobs and the
+All are :data:`metrics.runner.Execute` functions: they take the jobs and the
 function that runs one (:func:`metrics.runner.run_job`) and yield each
 outcome as it finishes; :func:`metrics.runner.run_missing` writes the result
-files. ``ray`` makes one Ray task per (scene, method, protocol) and assumes no
-shared file system: each scene folder is packed once into the object store
+files. ``processes`` runs the light methods' jobs (those not ``heavy``: the 2D
+methods take milliseconds) here first, then the heavy ones (neural3d's trainings)
+in spawned processes, as many at once as their ``resources`` fit in this
+machine's cores and GPUs (:mod:`dataset.executors.process_tasks`): two
+one-thread trainings side by side on two cores, or eight on one GPU when each
+reserves an eighth of it. A heavy job whose process dies is recorded as a
+failed run; the others go on. ``ray`` makes one Ray task per (scene, method,
+protocol) and assumes no shared file system: each scene folder is packed once into the object store
 and unpacked by the worker into a temporary folder; the outcome and the
 method's artefacts folder (a trained method's run folder, with its mesh
 and footprint) come back, and this process alone writes them,
@@ -23,6 +30,7 @@ from pathlib import Path
 
 from dataset.core.atomic import atomic_directory
 from dataset.executors.folder_pack import pack_folder, unpack_folder
+from dataset.executors.process_tasks import Capacity, machine_capacity, run_in_processes
 from dataset.executors.ray_tasks import (
     EXECUTORS,
     ExecutorName,
@@ -34,9 +42,11 @@ from dataset.executors.ray_tasks import (
 from metrics.runner import Execute, Job, Outcome, RunOne, execute_local
 
 
-def make_executor(name: ExecutorName, ray: RayConfig | None = None) -> Execute:
+def make_executor(name: ExecutorName, ray: RayConfig | None = None,
+                  cpus: int | None = None) -> Execute:
     """The executor called ``name``; ``ray`` says where a ``ray`` executor's tasks run
-    (default: a Ray started on this machine).
+    (default: a Ray started on this machine), ``cpus`` how many cores a ``processes``
+    executor's runs may fill at once (default: this machine's; its GPUs are counted).
 
     Raises
     ------
@@ -45,9 +55,37 @@ def make_executor(name: ExecutorName, ray: RayConfig | None = None) -> Execute:
     """
     if name == "local":
         return execute_local
+    if name == "processes":
+        return partial(execute_processes, cpus=cpus)
     if name == "ray":
         return partial(execute_ray, config=ray if ray is not None else RayConfig())
     raise ValueError(f"unknown executor {name!r}; choose from {', '.join(EXECUTORS)}")
+
+
+def execute_processes(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None = None,
+                      capacity: Capacity | None = None) -> Iterator[tuple[int, Outcome]]:
+    """Run the light jobs here, one after the other, then the heavy ones each in a spawned
+    process, as many at once as their ``spec.resources`` fit in ``capacity`` (default:
+    ``cpus`` cores, or this machine's, and its GPUs if a job reserves one); yield
+    ``(index, outcome)`` as they finish. A heavy job that raises, or whose process dies, is
+    a failed outcome.
+    """
+    heavy = [i for i, j in enumerate(jobs) if j.spec.heavy]
+    for i, job in enumerate(jobs):
+        if not job.spec.heavy:
+            yield i, run_one(job)
+    if not heavy:
+        return
+    if capacity is None:
+        capacity = machine_capacity(
+            cpus, count_gpus=any(jobs[i].spec.resources.gpus for i in heavy))
+    calls = [((jobs[i],), jobs[i].spec.resources) for i in heavy]
+    for k, value in run_in_processes(run_one, calls, capacity):
+        job = jobs[heavy[k]]
+        if isinstance(value, TaskLost):
+            value = Outcome(job.scene_dir.name, job.spec.name, job.protocol, "failed",
+                            reason=f"its process failed: {value.reason}")
+        yield heavy[k], value
 
 
 def execute_ray(

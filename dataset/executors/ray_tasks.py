@@ -197,16 +197,32 @@ def _first_line(exc: BaseException) -> str:
     return f"{type(shown).__name__}: {text[0] if text else ''}".strip()
 
 
-ExecutorName = Literal["local", "ray"]
+ExecutorName = Literal["local", "processes", "ray"]
 EXECUTORS: tuple[str, ...] = get_args(ExecutorName)
 
 
-def add_executor_arguments(parser: argparse.ArgumentParser, local_help: str, task: str) -> None:
-    """``--executor {local,ray}`` and ``--ray-address`` on a command line: ``local_help`` says
-    what ``local`` does there, ``task`` what one Ray task is."""
-    parser.add_argument("--executor", choices=EXECUTORS, default="local",
-                        help=f"local ({local_help}, the default) or ray (one Ray task per "
-                        f"{task}, on a Ray started here or on --ray-address; docs/cluster.md)")
+def add_executor_arguments(parser: argparse.ArgumentParser, local_help: str, task: str,
+                           processes_help: str | None = None) -> None:
+    """``--executor`` and ``--ray-address`` on a command line: ``local_help`` says what
+    ``local`` does there, ``task`` what one Ray task is; with ``processes_help`` (what
+    ``processes`` does there) also the ``processes`` executor and ``--cpus``."""
+    choices = EXECUTORS if processes_help else tuple(e for e in EXECUTORS if e != "processes")
+    processes = f", processes ({processes_help})" if processes_help else ""
+    parser.add_argument("--executor", choices=choices, default="local",
+                        help=f"local ({local_help}, the default){processes} or ray (one Ray "
+                        f"task per {task}, on a Ray started here or on --ray-address; "
+                        "docs/cluster.md)")
     parser.add_argument("--ray-address", metavar="ADDR",
                         help="with --executor ray: a running cluster (HOST:PORT as printed by "
                         "`ray start --head`, or auto); default: start Ray on this machine")
+    if processes_help:
+        parser.add_argument("--cpus", type=_positive_int, metavar="N",
+                            help="cores the runs may fill at once: with --executor processes, "
+                            "and a Ray started here (default: all of this machine's)")
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {value}")
+    return value

@@ -1,0 +1,146 @@
+"""The processes executor: heavy runs in processes of their own, as many at once as their
+reservations fit, give the same results as the local executor; a run whose process dies is a
+failed run alone; Ctrl-C stops the trainings with their checkpoints saved and whole result
+files only; neural3d reserves its threads on CPU and a share of the GPU on CUDA.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import asdict, replace
+
+import pytest
+
+from dataset.core.results import read_result
+from metrics.executors import make_executor
+from metrics.methods import method_specs
+from metrics.runner import find_scenes, run_missing
+from neural3d.method import METHOD_NEURAL3D, Neural3dBudget, record_config, reserve
+
+
+def _quiet(_message):
+    pass
+
+
+def _dies_on_first_scene(scene_dir, protocol):
+    """2D-S, except that the process dies on tiny_l_shaped (as under the OOM killer)."""
+    if scene_dir.name == "tiny_l_shaped":
+        os._exit(3)
+    return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
+
+
+def _without_times(outcomes):
+    return [(o.scene, o.method, o.protocol, o.status,
+             None if o.result is None else replace(o.result, wall_time_s=0.0))
+            for o in outcomes]
+
+
+def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path):
+    scenes = find_scenes(tiny_benchmark)
+    light = method_specs(("2D-SS",), ("ideal",), tmp_path)[0]
+    heavy = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True)
+    local = run_missing(scenes, [light, heavy], tmp_path / "local", log=_quiet)
+    processes = run_missing(scenes, [light, heavy], tmp_path / "processes", log=_quiet,
+                            execute=make_executor("processes", cpus=2))
+    assert _without_times(processes) == _without_times(local)
+    assert len(processes) == 3 * 2 and all(o.status == "ran" for o in processes)
+    assert sorted(p.name for p in (tmp_path / "processes").iterdir()) == sorted(
+        p.name for p in (tmp_path / "local").iterdir())
+
+
+def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
+    scenes = find_scenes(tiny_benchmark)
+    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
+                   run=_dies_on_first_scene)
+    messages = []
+    outcomes = run_missing(scenes, [spec], tmp_path / "results", log=messages.append,
+                           execute=make_executor("processes", cpus=2))
+    status = {o.scene: (o.status, o.reason) for o in outcomes}
+    assert status["tiny_l_shaped"][0] == "failed"
+    assert "its process failed" in status["tiny_l_shaped"][1]
+    assert "exited with code 3" in status["tiny_l_shaped"][1]
+    assert [s for s, (st, _) in status.items() if st == "ran"] == [
+        s.name for s in scenes if s.name != "tiny_l_shaped"]
+    assert len(messages) == 1
+    assert not (tmp_path / "results" / "tiny_l_shaped__2D-S__ideal.json").exists()
+
+
+def test_neural3d_reserves_its_threads_or_a_share_of_the_gpu_and_records_neither_share():
+    assert reserve(Neural3dBudget(threads=1)) == (1.0, 0.0)
+    assert reserve(Neural3dBudget(threads=3)) == (3.0, 0.0)
+    assert reserve(Neural3dBudget(device="cuda")) == (1.0, 1.0 / 8)
+    assert reserve(Neural3dBudget(device="cuda:0", runs_per_gpu=4)) == (1.0, 0.25)
+    assert METHOD_NEURAL3D.cpus_gpus(Neural3dBudget(threads=1)) == (1.0, 0.0)
+    # The share changes no result, so results made with another share are reused.
+    assert record_config(Neural3dBudget(runs_per_gpu=2)) == record_config(Neural3dBudget())
+    assert "runs_per_gpu" in asdict(Neural3dBudget())
+    with pytest.raises(ValueError, match="runs per GPU must be >= 1"):
+        Neural3dBudget(runs_per_gpu=0)
+
+
+NEURAL3D_TINY = ["--methods", "neural3d", "--neural3d-preset", "tiny", "--neural3d-steps",
+                 "20", "--neural3d-resolution", "24", "--neural3d-threads", "1"]
+
+
+@pytest.mark.slow
+def test_neural3d_trained_two_at_a_time_gives_the_local_results(tiny_benchmark, tmp_path):
+    """The real heavy path: neural3d's spec travels to spawned processes, trains there
+    (torch with one thread in each) and its run folders land where the local run's do."""
+    results = {}
+    for executor in ("local", "processes"):
+        out = tmp_path / executor
+        command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
+                   *NEURAL3D_TINY, "--results", str(out / "results"), "--out",
+                   str(out / "compare"), "--executor", executor, "--cpus", "2"]
+        done = subprocess.run(command, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr[-3000:]
+        results[executor] = {p.name: replace(read_result(p), wall_time_s=0.0)
+                             for p in sorted((out / "results").glob("*.json"))}
+        runs = sorted(p.name for p in (out / "results" / "neural3d_runs").iterdir())
+        assert runs == sorted(s.name for s in find_scenes(tiny_benchmark))
+    assert len(results["local"]) == 3
+    assert results["processes"] == results["local"]  # every field, the provenance included
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_the_trainings_with_checkpoints_and_whole_results(
+        tiny_benchmark, tmp_path):
+    """SIGINT after the 2D results, while two neural3d trainings (100000 steps) run in their
+    processes: the CLI exits 130 at once, each training saved its checkpoint (SIGTERM), and
+    every result file is whole."""
+    results = tmp_path / "results"
+    command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
+               "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-preset", "tiny",
+               "--neural3d-steps", "100000", "--neural3d-threads", "1", "--results",
+               str(results), "--out", str(tmp_path / "out"), "--executor", "processes",
+               "--cpus", "2"]
+    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    runs = results / "neural3d_runs"
+    try:
+        deadline = time.monotonic() + 300
+        while not (runs.is_dir() and len([p for p in runs.iterdir()
+                                          if (p / "config.json").exists()]) == 2):
+            if proc.poll() is not None or time.monotonic() > deadline:
+                proc.kill()
+                pytest.fail(f"two trainings did not start: {proc.communicate()[1][-3000:]}")
+            time.sleep(0.1)
+        time.sleep(3.0)
+        tic = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        _, stderr = proc.communicate(timeout=120)
+    finally:  # never leave a 100000-step training behind
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130, stderr
+    assert time.monotonic() - tic < 60 and "interrupted" in stderr
+    written = sorted(p for p in results.iterdir() if p.is_file())
+    assert [p.name for p in written] == [f"{s.name}__2D-S__ideal.json"
+                                         for s in find_scenes(tiny_benchmark)]
+    for path in written:
+        read_result(path)
+    started = [p for p in runs.iterdir() if (p / "config.json").exists()]
+    assert len(started) == 2 and all((p / "checkpoint.pt").is_file() for p in started)
