@@ -159,7 +159,7 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
     default = DefaultBenchmark() if args.data is None else None
     data = (default.folder if default is not None else args.data).resolve()
     names = (args.explain[1],) if args.explain else _listed(args.methods)
-    runs_here = args.executor in ("local", "processes") and not (args.no_run or args.explain)
+    runs_here = args.executor != "ray" and not (args.no_run or args.explain)
     configs = method_configs(args, methods, names, runs_here=runs_here,
                              short_run=default is not None or args.robustness)
     return CompareRequest(

@@ -1,5 +1,6 @@
 """Where the comparison's missing runs execute: here, one after the other (``local``); here,
 several at once in processes of their own (``processes``); or on a Ray cluster (``ray``).
+``auto`` picks ``processes`` when two heavy runs fit at once, else ``local``.
 
 All are :data:`metrics.runner.Execute` functions: they take the jobs and the
 function that runs one (:func:`metrics.runner.run_job`) and yield each
@@ -53,6 +54,8 @@ def make_executor(name: ExecutorName, ray: RayConfig | None = None,
     ValueError
         If ``name`` is not an executor.
     """
+    if name == "auto":
+        return partial(execute_auto, cpus=cpus)
     if name == "local":
         return execute_local
     if name == "processes":
@@ -60,6 +63,21 @@ def make_executor(name: ExecutorName, ray: RayConfig | None = None,
     if name == "ray":
         return partial(execute_ray, config=ray if ray is not None else RayConfig())
     raise ValueError(f"unknown executor {name!r}; choose from {', '.join(EXECUTORS)}")
+
+
+def execute_auto(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None = None
+                 ) -> Iterator[tuple[int, Outcome]]:
+    """:func:`execute_processes` when two or more heavy jobs are to run and two of them fit
+    at once in this machine (``cpus`` cores, or all of them, and its GPU): one-thread
+    trainings on two cores, or trainings sharing a GPU; else :func:`execute_local`."""
+    heavy = [j.spec.resources for j in jobs if j.spec.heavy]
+    if len(heavy) >= 2:
+        capacity = machine_capacity(cpus, count_gpus=any(r.gpus for r in heavy))
+        if min(r.cpus for r in heavy) * 2 <= capacity.cpus and (
+                min(r.gpus for r in heavy) * 2 <= capacity.gpus + 1e-9):
+            yield from execute_processes(jobs, run_one, capacity=capacity)
+            return
+    yield from execute_local(jobs, run_one)
 
 
 def execute_processes(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None = None,

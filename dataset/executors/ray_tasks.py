@@ -197,28 +197,33 @@ def _first_line(exc: BaseException) -> str:
     return f"{type(shown).__name__}: {text[0] if text else ''}".strip()
 
 
-ExecutorName = Literal["local", "processes", "ray"]
+ExecutorName = Literal["auto", "local", "processes", "ray"]
 EXECUTORS: tuple[str, ...] = get_args(ExecutorName)
 
 
 def add_executor_arguments(parser: argparse.ArgumentParser, local_help: str, task: str,
                            processes_help: str | None = None) -> None:
     """``--executor`` and ``--ray-address`` on a command line: ``local_help`` says what
-    ``local`` does there, ``task`` what one Ray task is; with ``processes_help`` (what
-    ``processes`` does there) also the ``processes`` executor and ``--cpus``."""
-    choices = EXECUTORS if processes_help else tuple(e for e in EXECUTORS if e != "processes")
-    processes = f", processes ({processes_help})" if processes_help else ""
-    parser.add_argument("--executor", choices=choices, default="local",
-                        help=f"local ({local_help}, the default){processes} or ray (one Ray "
-                        f"task per {task}, on a Ray started here or on --ray-address; "
-                        "docs/cluster.md)")
+    ``local`` does there, ``task`` what one Ray task is. With ``processes_help`` (what
+    ``processes`` does there) also ``processes``, ``auto`` (the default then: ``processes``
+    when two heavy runs fit at once, else ``local``) and ``--cpus``."""
+    if processes_help:
+        choices, default = EXECUTORS, "auto"
+        what = (f"auto (the default: processes when two heavy runs fit at once, else local), "
+                f"local ({local_help}), processes ({processes_help})")
+    else:
+        choices, default = ("local", "ray"), "local"
+        what = f"local ({local_help}, the default)"
+    parser.add_argument("--executor", choices=choices, default=default,
+                        help=f"{what} or ray (one Ray task per {task}, on a Ray started here "
+                        "or on --ray-address; docs/cluster.md)")
     parser.add_argument("--ray-address", metavar="ADDR",
                         help="with --executor ray: a running cluster (HOST:PORT as printed by "
                         "`ray start --head`, or auto); default: start Ray on this machine")
     if processes_help:
         parser.add_argument("--cpus", type=_positive_int, metavar="N",
-                            help="cores the runs may fill at once: with --executor processes, "
-                            "and a Ray started here (default: all of this machine's)")
+                            help="cores the runs may fill at once: with --executor processes "
+                            "or auto, and a Ray started here (default: all of this machine's)")
 
 
 def _positive_int(text: str) -> int:

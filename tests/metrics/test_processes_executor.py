@@ -10,10 +10,13 @@ import subprocess
 import sys
 import time
 from dataclasses import asdict, replace
+from functools import partial
+from pathlib import Path
 
 import pytest
 
 from dataset.core.results import read_result
+from dataset.executors.ray_tasks import TaskResources
 from metrics.executors import make_executor
 from metrics.methods import method_specs
 from metrics.runner import find_scenes, run_missing
@@ -28,6 +31,12 @@ def _dies_on_first_scene(scene_dir, protocol):
     """2D-S, except that the process dies on tiny_l_shaped (as under the OOM killer)."""
     if scene_dir.name == "tiny_l_shaped":
         os._exit(3)
+    return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
+
+
+def _2ds_noting_its_process(folder, scene_dir, protocol):
+    """2D-S, writing the id of the process it ran in into ``folder``."""
+    Path(folder, f"{scene_dir.name}.pid").write_text(str(os.getpid()))
     return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
 
 
@@ -48,6 +57,21 @@ def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path
     assert len(processes) == 3 * 2 and all(o.status == "ran" for o in processes)
     assert sorted(p.name for p in (tmp_path / "processes").iterdir()) == sorted(
         p.name for p in (tmp_path / "local").iterdir())
+
+
+def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path):
+    scenes = find_scenes(tiny_benchmark)
+    for cores, expect_here in ((1.0, False), (2.0, True)):
+        pids = tmp_path / f"pids-{cores}"
+        pids.mkdir()
+        spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
+                       run=partial(_2ds_noting_its_process, str(pids)),
+                       resources=TaskResources(cpus=cores))
+        outcomes = run_missing(scenes, [spec], tmp_path / f"results-{cores}", log=_quiet,
+                               execute=make_executor("auto", cpus=2))
+        assert [o.status for o in outcomes] == ["ran"] * 3
+        ran_here = {int(p.read_text()) == os.getpid() for p in pids.iterdir()}
+        assert ran_here == {expect_here}, f"{cores} cores a run"
 
 
 def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
