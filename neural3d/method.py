@@ -85,9 +85,12 @@ OPTIONS = (
 )
 # The built-in default comparison (tiny benchmark) and the robustness study: the smallest
 # step budget measured with every building within WWR error 5 % and footprint IoU 0.96
-# (docs/decisions.md, 2026-11-24 "neural3d default budget"), marching cubes at 128 and one
-# eval frame (rendering the preset's four costs about a minute of CPU per building).
-SHORT_RUN = {"steps": 2000, "resolution": 128, "eval_frames": 1}
+# (docs/decisions.md, 2026-11-24 "neural3d default budget"), marching cubes at 128, one
+# eval frame (rendering the preset's four costs about a minute of CPU per building) and one
+# torch thread, so that the comparison trains two buildings at once on two cores, each
+# in its own process, which gets more steps out of a core than two threads on one building
+# (docs/decisions.md, 2026-11-27 "neural3d one thread a building").
+SHORT_RUN = {"steps": 2000, "resolution": 128, "eval_frames": 1, "threads": 1}
 
 
 def check_budget(budget: Neural3dBudget, runs_here: bool) -> None:
