@@ -24,6 +24,7 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from datetime import datetime, timezone
+from functools import partial
 from pathlib import Path
 
 from dataset.core.atomic import write_json_atomic, write_text_atomic
@@ -252,16 +253,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             return explain_one(request, *args.explain)
         check_output_folder(request.results, "--results")
         check_output_folder(request.out, "--out")
+        execute = make_executor(
+            args.executor, RayConfig(address=args.ray_address, num_cpus=args.cpus),
+            cpus=args.cpus)
         if args.robustness:
             return robustness_study(request, RobustnessStudy(
-                seed=args.degrade_seed, heavy_levels=args.robustness_heavy))
+                seed=args.degrade_seed, heavy_levels=args.robustness_heavy), execute=execute)
         mode = compare_on_masks if request.masks is not None else compare_once
         return mode(
             request, f"python -m metrics.compare {argv_text}".strip(),
-            allow_run=not args.no_run, reuse_stale=args.reuse_stale,
-            execute=make_executor(
-                args.executor, RayConfig(address=args.ray_address, num_cpus=args.cpus),
-                cpus=args.cpus))
+            allow_run=not args.no_run, reuse_stale=args.reuse_stale, execute=execute)
 
     return run_cli("metrics.compare", body, debug=args.debug, interrupted=(
         "interrupted: finished results are kept; run again to continue"))
@@ -310,12 +311,15 @@ def compare_on_masks(request: CompareRequest, command: str, *, allow_run: bool,
     return 0
 
 
-def robustness_study(request: CompareRequest, study: RobustnessStudy) -> int:
-    """``--robustness``: the clean comparison and each degraded one; print the study's table."""
+def robustness_study(request: CompareRequest, study: RobustnessStudy, *,
+                     execute: Execute = execute_local) -> int:
+    """``--robustness``: the clean comparison and each degraded one, their missing runs
+    made with ``execute``; print the study's table."""
     _prepare(request, study.heavy_comparisons)
     out = request.out / "robustness"
     rows = run_study(request.data, request.results / "robustness", out,
-                     lambda results: _specs(request, results), study, compare)
+                     lambda results: _specs(request, results), study,
+                     partial(compare, execute=execute))
     print(to_text(robustness_table(rows)))
     print(f"wrote robustness.csv/.md/.png to {out}")
     return 0
