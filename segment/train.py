@@ -57,7 +57,7 @@ class TrainConfig:
     ``max_minutes``: a safety cap; a run it stops is marked ``cut_short``.
     """
 
-    steps: int = 3000
+    steps: int = 6000
     batch: int = 12
     learning_rate: float = 3e-3
     weight_decay: float = 1e-4
