@@ -246,7 +246,10 @@ def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     results = tmp_path / "results"
     command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
                "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-steps", "100000",
-               "--results", str(results), "--out", str(tmp_path / "out"), "--executor", "ray"]
+               "--results", str(results), "--out", str(tmp_path / "out"), "--executor", "ray",
+               # three CPUs for its Ray: a training (2) and a 2D-S task (1) fit at once, so a
+               # 2D-S result comes even when Ray starts the trainings first
+               "--cpus", "3"]
     # SIGINT as in a terminal, even where this test runs with it ignored (a background job)
     proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
