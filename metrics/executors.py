@@ -37,6 +37,7 @@ from dataset.executors.ray_tasks import (
     ExecutorName,
     RayConfig,
     TaskLost,
+    TaskResources,
     ray_session,
     run_tasks,
 )
@@ -72,21 +73,20 @@ def execute_auto(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None = Non
     trainings on two cores, or trainings sharing a GPU; else :func:`execute_local`."""
     heavy = [j.spec.resources for j in jobs if j.spec.heavy]
     if len(heavy) >= 2:
-        capacity = machine_capacity(cpus, count_gpus=any(r.gpus for r in heavy))
+        capacity = _capacity(heavy, cpus)
         if min(r.cpus for r in heavy) * 2 <= capacity.cpus and (
                 min(r.gpus for r in heavy) * 2 <= capacity.gpus + 1e-9):
-            yield from execute_processes(jobs, run_one, capacity=capacity)
+            yield from execute_processes(jobs, run_one, cpus=cpus)
             return
     yield from execute_local(jobs, run_one)
 
 
-def execute_processes(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None = None,
-                      capacity: Capacity | None = None) -> Iterator[tuple[int, Outcome]]:
+def execute_processes(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None = None
+                      ) -> Iterator[tuple[int, Outcome]]:
     """Run the light jobs here, one after the other, then the heavy ones each in a spawned
-    process, as many at once as their ``spec.resources`` fit in ``capacity`` (default:
-    ``cpus`` cores, or this machine's, and its GPUs if a job reserves one); yield
-    ``(index, outcome)`` as they finish. A heavy job that raises, or whose process dies, is
-    a failed outcome.
+    process, as many at once as their ``spec.resources`` fit in ``cpus`` cores (default:
+    this machine's) and its GPU if a job reserves one; yield ``(index, outcome)`` as they
+    finish. A heavy job that raises, or whose process dies, is a failed outcome.
     """
     heavy = [i for i, j in enumerate(jobs) if j.spec.heavy]
     for i, job in enumerate(jobs):
@@ -94,16 +94,20 @@ def execute_processes(jobs: Sequence[Job], run_one: RunOne, *, cpus: int | None 
             yield i, run_one(job)
     if not heavy:
         return
-    if capacity is None:
-        capacity = machine_capacity(
-            cpus, count_gpus=any(jobs[i].spec.resources.gpus for i in heavy))
     calls = [((jobs[i],), jobs[i].spec.resources) for i in heavy]
+    capacity = _capacity([resources for _, resources in calls], cpus)
     for k, value in run_in_processes(run_one, calls, capacity):
         job = jobs[heavy[k]]
         if isinstance(value, TaskLost):
             value = Outcome(job.scene_dir.name, job.spec.name, job.protocol, "failed",
                             reason=f"its process failed: {value.reason}")
         yield heavy[k], value
+
+
+def _capacity(reserved: Sequence[TaskResources], cpus: int | None) -> Capacity:
+    """This machine's capacity for runs that reserve ``reserved`` (its GPU counted only if
+    one of them reserves a share of it, so that torch is imported only then)."""
+    return machine_capacity(cpus, count_gpus=any(r.gpus for r in reserved))
 
 
 def execute_ray(
