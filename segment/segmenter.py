@@ -15,7 +15,7 @@ answer of the wrong shape, dtype or class ids. docs/segment.md has a worked exam
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
@@ -58,28 +58,58 @@ def network_segmenter(weights: str | Path = DEFAULT_WEIGHTS, *, threads: int = 2
     """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
-    model, _ = load_network(weights)
+    model, record = load_network(weights)
+    offsets = calibrated_offsets(record, weights)
     identity = {"weights": file_fingerprint(weights), "code": code_fingerprint("segment"),
                 "torch": library_version("torch")}
     label = name or (DEFAULT_NAME if Path(weights) == DEFAULT_WEIGHTS else str(weights))
 
     def segment(rgb: np.ndarray) -> np.ndarray:
-        return predict_labels(model, rgb, threads=threads)
+        return predict_labels(model, rgb, threads=threads, logit_offsets=offsets)
 
     return Segmenter(label, segment, identity)
 
 
-def predict_labels(model: UNet, rgb: np.ndarray, *, threads: int = 2) -> np.ndarray:
-    """Most likely class of every pixel: (H, W, 3) uint8 RGB -> (H, W) uint8 ids."""
+def calibrated_offsets(record: dict[str, Any], weights: str | Path) -> tuple[float, ...] | None:
+    """The logit offsets ``segment.calibrate`` wrote into a weights record (one per class),
+    or ``None`` for uncalibrated weights.
+
+    Raises
+    ------
+    ValueError
+        If the record's offsets are not one finite number per class.
+    """
+    offsets = (record.get("calibration") or {}).get("logit_offsets")
+    if offsets is None:
+        return None
+    if (not isinstance(offsets, list) or len(offsets) != NUM_CLASSES
+            or not all(isinstance(v, (int, float)) and np.isfinite(v) for v in offsets)):
+        raise ValueError(f"{weights}: calibration logit_offsets must be {NUM_CLASSES} finite "
+                         f"numbers, got {offsets!r}; calibrate again with `python -m "
+                         f"segment.calibrate`")
+    return tuple(float(v) for v in offsets)
+
+
+def predict_logits(model: UNet, rgb: np.ndarray, *, threads: int = 2) -> torch.Tensor:
+    """The network's class scores of every pixel: (H, W, 3) uint8 RGB -> (C, H, W) float32."""
     previous = torch.get_num_threads()
     torch.set_num_threads(threads)
     try:
         with torch.inference_mode():
             x = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1)[None].float() / 255
-            logits = model(x.contiguous(memory_format=torch.channels_last))
-            return logits[0].argmax(0).to(torch.uint8).numpy()
+            return model(x.contiguous(memory_format=torch.channels_last))[0]
     finally:
         torch.set_num_threads(previous)
+
+
+def predict_labels(model: UNet, rgb: np.ndarray, *, threads: int = 2,
+                   logit_offsets: Sequence[float] | None = None) -> np.ndarray:
+    """Most likely class of every pixel: (H, W, 3) uint8 RGB -> (H, W) uint8 ids, after
+    adding ``logit_offsets`` (one per class; a calibration, :mod:`segment.calibrate`)."""
+    logits = predict_logits(model, rgb, threads=threads)
+    if logit_offsets is not None:
+        logits = logits + torch.tensor(logit_offsets, dtype=logits.dtype)[:, None, None]
+    return logits.argmax(0).to(torch.uint8).numpy()
 
 
 def installed_segmenters() -> dict[str, EntryPoint]:
