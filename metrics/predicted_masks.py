@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -127,16 +128,17 @@ def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter,
 
 
 def with_predicted_masks(specs: Sequence[MethodSpec], segmenter: Segmenter) -> list[MethodSpec]:
-    """The same methods, their requested and written configs naming the segmenter."""
+    """The same methods, their requested and written configs naming the segmenter (each
+    run stays picklable, so a method still runs in a process of its own or on Ray)."""
     record = {"segmenter": segmenter.name, **segmenter.identity}
+    return [replace(s, config={**s.config, CONFIG_KEY: record},
+                    run=partial(_run_on_masks, s.run, record)) for s in specs]
 
-    def wrap(run):
-        def on_masks(scene_dir: Path, protocol: str, **kwargs):
-            result = run(scene_dir, protocol, **kwargs)
-            return replace(result, config={**result.config, CONFIG_KEY: record})
-        return on_masks
 
-    return [replace(s, config={**s.config, CONFIG_KEY: record}, run=wrap(s.run)) for s in specs]
+def _run_on_masks(run: Callable, record: dict[str, Any], scene_dir: Path, protocol: str, **kwargs):
+    """``run``'s result with the segmenter ``record`` in its config."""
+    result = run(scene_dir, protocol, **kwargs)
+    return replace(result, config={**result.config, CONFIG_KEY: record})
 
 
 def compare_on_predicted_masks(

@@ -126,3 +126,46 @@ def test_a_plugin_with_wrong_answers_stops_the_run_and_leaves_no_masks(one_scene
     cache = tmp_path / "data-masks" / "predicted-bad-masks"
     assert not cache.exists() or list(cache.iterdir()) == []
     assert not (tmp_path / "r" / "masks").exists()
+
+
+def test_a_method_on_predicted_masks_still_travels_to_another_process(one_scene, tmp_path):
+    """The wrapped run pickles (the processes and Ray executors send it to another process)
+    and, unpickled, gives the method's result with the segmenter in its config."""
+    import pickle
+    from dataclasses import replace
+
+    from metrics.methods import method_specs
+    from metrics.predicted_masks import CONFIG_KEY, with_predicted_masks
+
+    spec = method_specs(("2D-S",), ("ideal",), tmp_path / "results")[0]
+    scene = next(one_scene.iterdir())
+    segmenter = Segmenter("toy", lambda rgb: rgb[..., 0] * 0, {"weights": "abc"})
+    wrapped = with_predicted_masks([spec], segmenter)[0]
+    travelled = pickle.loads(pickle.dumps(wrapped.run))
+    result = travelled(scene, "ideal")
+    plain = spec.run(scene, "ideal")
+    assert result.config[CONFIG_KEY] == {"segmenter": "toy", "weights": "abc"}
+    assert wrapped.config[CONFIG_KEY] == result.config[CONFIG_KEY]
+    assert replace(result, config=plain.config, wall_time_s=0.0) == replace(
+        plain, wall_time_s=0.0)
+
+
+@pytest.mark.slow
+def test_neural3d_trains_on_predicted_masks_in_processes_of_its_own(tiny_benchmark, tmp_path):
+    """`--masks predicted` with the processes executor (the default `auto` picks it when two
+    trainings fit): every building gets a neural3d result on exact and on predicted masks."""
+    import subprocess
+
+    results = tmp_path / "results"
+    done = subprocess.run(
+        [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
+         "--methods", "neural3d", "--neural3d-preset", "tiny", "--neural3d-steps", "20",
+         "--neural3d-resolution", "24", "--neural3d-threads", "1", "--masks", "predicted",
+         "--masks-threads", "1", "--executor", "processes", "--cpus", "2",
+         "--results", str(results), "--out", str(tmp_path / "out")],
+        capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert "failed" not in done.stdout
+    assert len(list(results.glob("*__neural3d__train.json"))) == 3
+    predicted = list((results / "masks").glob("*/*__neural3d__train.json"))
+    assert len(predicted) == 3, done.stdout[-2000:]
