@@ -102,7 +102,7 @@ def unbiased_offset(every: np.ndarray, window: np.ndarray) -> float:
     # predicted(offset = -edge) = pixels with margin above edge: a cumulative sum from the top
     above = np.concatenate([np.cumsum(every[::-1])[::-1], [0]])
     best = int(np.argmin(np.abs(above - window.sum())))
-    return float(-MARGIN_EDGES[best]) + 0.0
+    return float(-MARGIN_EDGES[best]) + 0.0  # + 0.0: 0.0 rather than -0.0 at the middle edge
 
 
 def calibrate_window(model: UNet, scenes: Sequence[TrainingScene], frames: int = 24,
