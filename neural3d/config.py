@@ -69,6 +69,10 @@ class TrainConfig:
     # transparent: their colour and semantics are not evaluated; ~60 % of the samples late
     # in training); 0 = keep every sample
     min_sample_weight: float = 1e-4
+    # samples whose weight, guessed before the field pass from the up-sampling's SDF at the
+    # section ends (neural3d.rendering.neus.edge_alpha), is at most this are not evaluated
+    # at all (no SDF gradient, no eikonal term: transparent); 0 = evaluate every sample
+    min_estimated_weight: float = 0.0
     cos_anneal_steps: int = 0  # NeuS cos-anneal length; 0 = no annealing
     rgb_weight: float = 1.0
     eikonal_weight: float = 0.1
@@ -110,6 +114,9 @@ class TrainConfig:
         if not 0.0 <= self.min_sample_weight < 1.0:
             raise ValueError(f"TrainConfig.min_sample_weight must be in [0, 1), got "
                              f"{self.min_sample_weight}")
+        if not 0.0 <= self.min_estimated_weight < 1.0:
+            raise ValueError(f"TrainConfig.min_estimated_weight must be in [0, 1), got "
+                             f"{self.min_estimated_weight}")
         if self.eval_rays_per_frame < 0:
             raise ValueError(f"TrainConfig.eval_rays_per_frame must be >= 0 (0 = every pixel), "
                              f"got {self.eval_rays_per_frame}")

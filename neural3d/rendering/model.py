@@ -11,6 +11,7 @@ from torch.profiler import record_function
 from neural3d.config import TrainConfig
 from neural3d.field.fields import SemanticSDF
 from neural3d.rendering.neus import (
+    edge_alpha,
     neus_alpha,
     render_accumulation,
     render_depth,
@@ -65,26 +66,36 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
         o, d = origins[idx], dirs[idx]
         t = uniform_samples(near[idx], far[idx], config.samples_uniform, perturb=training,
                             generator=generator)
-        t, _ = neus_upsample(field.sdf, o, d, t, config.samples_importance,
-                             config.upsample_steps)
+        t, sdf_edges = neus_upsample(field.sdf, o, d, t, config.samples_importance,
+                                     config.upsample_steps)
         t_mid = (t[:, 1:] + t[:, :-1]) * 0.5
-        lengths = t[:, 1:] - t[:, :-1]
+        lengths = (t[:, 1:] - t[:, :-1]).reshape(-1)
         n_rays, n_samples = t_mid.shape
         pts = (o[:, None, :] + d[:, None, :] * t_mid[..., None]).reshape(-1, 3)
         dirs_s = d[:, None, :].expand(n_rays, n_samples, 3).reshape(-1, 3)
+        evaluated = None  # rows of the (R * S) samples the field is evaluated at; None = all
+        if config.min_estimated_weight > 0:
+            with torch.no_grad():
+                guess = weights_from_alpha(edge_alpha(sdf_edges, field.inv_s()))
+            evaluated = torch.nonzero(guess.reshape(-1) > config.min_estimated_weight).squeeze(1)
+            pts, dirs_s, lengths = pts[evaluated], dirs_s[evaluated], lengths[evaluated]
     sdf, feature, grad = field.sdf_feature_gradient(pts, create_graph=training)
+    n_all = n_rays * n_samples
     with record_function("neural3d.compositing"):
-        cos = (grad * dirs_s).sum(-1).reshape(n_rays, n_samples)
-        alpha = neus_alpha(sdf.reshape(n_rays, n_samples), cos, lengths, field.inv_s(),
+        cos = (grad * dirs_s).sum(-1)
+        alpha = neus_alpha(sdf, cos, lengths, field.inv_s(),
                            cos_anneal_ratio=cos_anneal_ratio(config, step))
-        weights = weights_from_alpha(alpha)
-        kept = None
+        weights = weights_from_alpha(_on_all_samples(alpha, evaluated, n_all)
+                                     .reshape(n_rays, n_samples))
+        kept = None  # rows of the evaluated samples the heads see; None = all
         if config.min_sample_weight > 0:  # light samples are dropped (as if transparent)
             heavy = weights.detach() > config.min_sample_weight
             weights = weights * heavy
-            kept = torch.nonzero(heavy.reshape(-1)).squeeze(1)
-    rgb = _at_samples(field.colour, kept, pts, dirs_s, grad, feature)
-    logits = _at_samples(field.semantic_logits, kept, feature)
+            heavy = heavy.reshape(-1) if evaluated is None else heavy.reshape(-1)[evaluated]
+            kept = torch.nonzero(heavy).squeeze(1)
+    rgb = _on_all_samples(_at_samples(field.colour, kept, pts, dirs_s, grad, feature),
+                          evaluated, n_all)
+    logits = _on_all_samples(_at_samples(field.semantic_logits, kept, feature), evaluated, n_all)
     with record_function("neural3d.compositing"):
         rgb = rgb.reshape(n_rays, n_samples, 3)
         logits = logits.reshape(n_rays, n_samples, field.num_classes)
@@ -101,6 +112,14 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
             accumulation=zeros.index_copy(0, idx, render_accumulation(weights)),
             sdf_gradients=grad,
         )
+
+
+def _on_all_samples(values: Tensor, rows: Tensor | None, n_all: int) -> Tensor:
+    """Values "(M, ...)" at ``rows`` of the ray samples -> "(n_all, ...)", zeros elsewhere
+    (samples the field was not evaluated at: transparent); ``values`` when ``rows`` is None."""
+    if rows is None:
+        return values
+    return values.new_zeros(n_all, *values.shape[1:]).index_copy(0, rows, values)
 
 
 def _at_samples(head, kept: Tensor | None, *inputs: Tensor) -> Tensor:

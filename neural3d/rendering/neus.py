@@ -28,6 +28,18 @@ def neus_alpha(sdf: Tensor, cos_dir_normal: Tensor, section_lengths: Tensor, inv
     return ((prev_cdf - next_cdf + 1e-5) / (prev_cdf + 1e-5)).clamp(0.0, 1.0)
 
 
+def edge_alpha(sdf_edges: Tensor, inv_s: Tensor | float) -> Tensor:
+    """Opacity "(R, S)" of each section from the SDF "(R, S + 1)" at its two ends (NeuS).
+
+    The original NeuS estimate, without normals: the drop of the logistic CDF of
+    sharpness ``inv_s`` between a section's ends. Used to guess which sections will
+    weigh anything before the field is evaluated with its gradient.
+    """
+    prev_cdf = torch.sigmoid(sdf_edges[:, :-1] * inv_s)
+    next_cdf = torch.sigmoid(sdf_edges[:, 1:] * inv_s)
+    return ((prev_cdf - next_cdf + 1e-5) / (prev_cdf + 1e-5)).clamp(0.0, 1.0)
+
+
 def weights_from_alpha(alpha: Tensor) -> Tensor:
     """"(R, S)" rendering weights alpha_i * prod_{j<i} (1 - alpha_j)."""
     trans = torch.cumprod(torch.cat([torch.ones_like(alpha[:, :1]), 1 - alpha + 1e-7], -1), -1)
