@@ -4,8 +4,8 @@ The grid follows instant-ngp: level ``l`` has resolution ``min_res * b**l``; a
 level whose vertices fit the table is stored densely (no collisions), finer
 levels are hashed. All levels live in one flat table so the lookup is a single
 gather. On CPU the gather reads each row as one wide element through
-``index_select`` and its backward is a per-feature ``bincount`` (together about
-5x faster than advanced indexing and ``index_add``); the eight trilinear
+``index_select`` and its backward adds each row as one element with ``index_add_``
+(together about 5x faster than advanced indexing and ``index_add``); the eight trilinear
 weights are built from per-axis factors without broadcasting, so no backward
 pass has to reduce over broadcast axes (docs/decisions.md, "grid encoding
 speed"; figures in docs/measurements/neural3d-training.md). Corner indices are int32 and
@@ -54,16 +54,33 @@ def gather_rows(table: Tensor, index: Tensor) -> Tensor:
     return packed.index_select(0, flat).view(table.dtype).reshape(*index.shape, features)
 
 
+_PAIR_DTYPES = {torch.float32: torch.complex64, torch.float64: torch.complex128}
+
+
 def scatter_add_rows(grad: Tensor, index: Tensor, rows: int) -> Tensor:
     """Adjoint of :func:`gather_rows` (its backward): "(*index, F)" -> "(rows, F)", the
     sum of the values gathered from each row.
 
-    A ``bincount`` per feature (accumulated in float64, then cast back), which
-    on CPU is about 3x faster than ``index_add_`` on the rows.
+    On CPU a row of 1 or 2 features is added as one element (a 2-feature row as one
+    complex number) by ``index_add_``, whose loop over a 1-D tensor is sequential, so
+    deterministic; its cost is the scatter, not the table (about 2x faster than a
+    ``bincount`` per feature, which writes a float64 table of every row per feature;
+    ``index_add_`` on "(rows, 2)" rows is about 5x slower than either). Elsewhere, or
+    with more features: a ``bincount`` per feature, accumulated in float64.
     """
     flat = index.reshape(-1)
-    per_feature = grad.reshape(len(flat), grad.shape[-1]).unbind(1)  # no -1: N may be 0
-    sums = [torch.bincount(flat, weights=g, minlength=rows) for g in per_feature]
+    features = grad.shape[-1]
+    values = grad.reshape(len(flat), features)  # no -1: N may be 0
+    if values.device.type == "cpu" and features <= 2 and values.dtype in _PAIR_DTYPES:
+        out = values.new_zeros(rows, features)
+        if features == 1:
+            out.view(rows).index_add_(0, flat, values.reshape(-1))
+        else:
+            pair = _PAIR_DTYPES[values.dtype]
+            out.view(pair).view(rows).index_add_(0, flat, values.contiguous().view(pair)
+                                                  .view(len(flat)))
+        return out
+    sums = [torch.bincount(flat, weights=g, minlength=rows) for g in values.unbind(1)]
     return torch.stack(sums, 1).to(grad.dtype)
 
 

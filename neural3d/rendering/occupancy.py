@@ -22,6 +22,17 @@ from torch import Tensor
 # Points per SDF call of a refresh: small enough to stay in the CPU's caches (a refresh of
 # 130k cells took 0.41 s of CPU in chunks of 2^14 points, 0.71-0.78 s in chunks of 2^16).
 REFRESH_CHUNK_POINTS = 2**14
+# Steepest SDF slope (change per unit length) at which a refresh that skips blocks of cells
+# still marks every cell a refresh of each cell would: a trained SDF's gradient norm
+# is held near 1 by the eikonal term.
+MAX_SDF_SLOPE = 2.0
+
+
+def _sdf_at(sdf_fn: Callable[[Tensor], Tensor], points: Tensor) -> Tensor:
+    """"(N,)" SDF at "(N, 3)" points, in cache-sized chunks."""
+    if len(points) == 0:
+        return points.new_zeros(0)
+    return torch.cat([sdf_fn(c) for c in points.split(REFRESH_CHUNK_POINTS)])
 
 
 class OccupancyGrid:
@@ -55,12 +66,41 @@ class OccupancyGrid:
         """Occupied where ``|sdf_fn(centre)| < half diagonal + margin``, grown by one cell.
 
         ``sdf_fn``: "(N, 3)" -> "(N,)" in normalised units; ``margin`` in the same units.
+        Block first: the SDF is taken at the centre of each block of 2 x 2 x 2 cells,
+        and at a block's cells only when that could pass the test (:meth:`near_surface`).
         """
-        centres = self.cell_centres()
-        sdf = torch.cat([sdf_fn(c) for c in centres.split(REFRESH_CHUNK_POINTS)])
-        near_surface = (sdf.abs() < 0.5 * math.sqrt(3) * self.cell + margin).reshape(self.shape)
+        near_surface = self.near_surface(sdf_fn, margin=margin)
         grown = F.max_pool3d(near_surface[None, None].float(), 3, stride=1, padding=1)
         self.occupied = grown[0, 0] > 0
+
+    @torch.no_grad()
+    def near_surface(self, sdf_fn: Callable[[Tensor], Tensor], *, margin: float,
+                     blocks: bool = True) -> Tensor:
+        """"(X, Y, Z)" bool: ``|sdf_fn(cell centre)| < h + margin``, h the cell's half diagonal.
+
+        ``blocks``: take the SDF at a block's cells only where ``|sdf(block centre)| <
+        (1 + MAX_SDF_SLOPE) h + margin``. Each cell centre lies within h of its block's
+        centre, so where the SDF changes by at most ``MAX_SDF_SLOPE`` per unit length
+        (an SDF: 1) a skipped block has no cell that passes: the result is that of every
+        cell (``blocks=False``) at about a fifth of the SDF queries on a building.
+        """
+        h = 0.5 * math.sqrt(3) * self.cell
+        if not blocks:
+            return (_sdf_at(sdf_fn, self.cell_centres()).abs() < h + margin).reshape(self.shape)
+        nb = [math.ceil(n / 2) for n in self.shape]
+        axes = [self.box_min[i] + (2 * torch.arange(n, device=self.box_min.device) + 1)
+                * self.cell for i, n in enumerate(nb)]
+        block_centres = torch.stack(torch.meshgrid(*axes, indexing="ij"), -1).reshape(-1, 3)
+        block_sdf = _sdf_at(sdf_fn, block_centres).reshape(nb)
+        maybe = block_sdf.abs() < (1 + MAX_SDF_SLOPE) * h + margin
+        for axis, n in enumerate(self.shape):
+            maybe = maybe.repeat_interleave(2, dim=axis).narrow(axis, 0, n)
+            if n % 2:  # the last block is half outside the box: its cells are always taken
+                maybe.select(axis, n - 1).fill_(True)
+        rows = torch.nonzero(maybe.reshape(-1)).squeeze(1)
+        near = torch.zeros(maybe.numel(), dtype=torch.bool, device=maybe.device)
+        near[rows] = _sdf_at(sdf_fn, self.cell_centres()[rows]).abs() < h + margin
+        return near.reshape(self.shape)
 
     def clip_rays(self, origins: Tensor, dirs: Tensor, near: Tensor, far: Tensor,
                   hit: Tensor) -> tuple[Tensor, Tensor, Tensor]:

@@ -70,7 +70,8 @@ def test_flat_gather_backward_matches_indexing():
 
 @pytest.mark.parametrize("features", [1, 2, 3, 4])
 def test_row_gather_and_its_scatter_match_indexing(features):
-    """The wide-element gather is exact; the bincount scatter equals index_add to 1e-5."""
+    """The wide-element gather is exact; the scatter (a row as one element, or a bincount per
+    feature) equals index_add on the rows to 1e-5, in the table's dtype."""
     gen = torch.Generator().manual_seed(features)
     table = torch.randn(50, features, generator=gen)
     index = torch.randint(0, 50, (9, 5, 8), generator=gen)
@@ -80,6 +81,22 @@ def test_row_gather_and_its_scatter_match_indexing(features):
                                                   grad.reshape(-1, features))
     got = scatter_add_rows(grad, index, 50)
     assert got.dtype == table.dtype and torch.allclose(got, expected, atol=1e-5)
+    assert torch.equal(scatter_add_rows(grad, index, 50), got)  # deterministic
+
+
+def test_row_scatter_is_deterministic_with_threads():
+    """Many values into few rows, where the order of the additions shows in the last bits:
+    every run gives the same bits at 2 threads."""
+    gen = torch.Generator().manual_seed(0)
+    index = torch.randint(0, 7, (200_000,), generator=gen, dtype=torch.int32)
+    grad = torch.randn(200_000, 2, generator=gen)
+    threads = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        runs = {scatter_add_rows(grad, index, 7).numpy().tobytes() for _ in range(5)}
+    finally:
+        torch.set_num_threads(threads)
+    assert len(runs) == 1
 
 
 def test_no_points_give_a_zero_gradient():

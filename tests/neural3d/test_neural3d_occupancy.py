@@ -106,3 +106,35 @@ def test_rays_beside_the_object_skip_the_field(grid):
     near_c, far_c, hit_c = grid.clip_rays(origins, dirs, near, far, hit)
     assert hit.all() and not hit_c[0] and hit_c[1]  # above the object / through it
     assert near[1] < near_c[1] < 3.0 - 0.3 and 3.0 + 0.3 < far_c[1] < far[1]
+
+
+@pytest.mark.parametrize("resolution", [32, 33, 47])
+def test_block_first_refresh_marks_the_cells_of_a_refresh_of_every_cell(resolution):
+    """On an SDF (slope 1) the block-first refresh gives the every-cell grid, odd sizes
+    included, with fewer SDF queries."""
+    grid = OccupancyGrid(LO, HI, resolution)
+    queries = []
+
+    def counted(p):
+        queries.append(len(p))
+        return box_sdf(p)
+
+    blocks = grid.near_surface(counted, margin=grid.cell)
+    n_blocks = sum(queries)
+    queries.clear()
+    every = grid.near_surface(counted, margin=grid.cell, blocks=False)
+    assert torch.equal(blocks, every) and every.any() and not every.all()
+    assert sum(queries) == every.numel() and n_blocks < 0.85 * every.numel()
+
+
+def test_block_first_refresh_needs_a_bounded_slope():
+    """An SDF steeper than MAX_SDF_SLOPE may hide a thin shell from the block centres: the
+    bound is what the refresh relies on (a sphere scaled by 50 has slope 50)."""
+    grid = OccupancyGrid(LO, HI, 32)
+
+    def steep(p):
+        return 50 * (p.norm(dim=-1) - 0.3)
+
+    blocks = grid.near_surface(steep, margin=0.0)
+    every = grid.near_surface(steep, margin=0.0, blocks=False)
+    assert every.any() and not torch.equal(blocks, every)

@@ -3,6 +3,7 @@
 import torch
 
 from neural3d.rendering.neus import (
+    edge_alpha,
     neus_alpha,
     render_accumulation,
     render_depth,
@@ -102,3 +103,20 @@ def test_renderers_mix_the_leftover_into_background():
 def test_weights_follow_transmittance():
     alpha = torch.tensor([[0.5, 0.5, 1.0]])
     assert torch.allclose(weights_from_alpha(alpha), torch.tensor([[0.5, 0.25, 0.25]]), atol=1e-6)
+
+
+def test_edge_alpha_telescopes_to_the_logistic_cdf():
+    """Along a ray that crosses a plane, sdf(t) = 0.3 - t: the transmittance after the
+    sections is the ratio of the logistic CDFs at the two ends (NeuS), whatever the spacing;
+    a section that leaves the surface (sdf rising) is transparent."""
+    inv_s = 50.0
+    t = torch.sort(torch.rand(1, 40, generator=torch.Generator().manual_seed(0)), -1)[0] * 0.6
+    t = torch.cat([torch.zeros(1, 1), t, torch.full((1, 1), 0.6)], -1)
+    alpha = edge_alpha(0.3 - t, inv_s)
+    transmittance = torch.prod(1 - alpha)
+    expected = torch.sigmoid(torch.tensor(-0.3 * inv_s)) / torch.sigmoid(torch.tensor(0.3 * inv_s))
+    assert abs(float(transmittance) - float(expected)) < 1e-3  # the 1e-5 terms, 42 sections
+    assert abs(float(weights_from_alpha(alpha).sum()) - (1 - float(expected))) < 1e-3
+    leaving = t - 0.3  # out of the solid: transparent wherever the CDF is not vanishing
+    seen = torch.sigmoid(leaving[:, :-1] * inv_s) > 1e-2
+    assert seen.sum() > 20 and edge_alpha(leaving, inv_s)[seen].max() < 2e-5  # the 1e-5 terms
