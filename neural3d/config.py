@@ -71,8 +71,10 @@ class TrainConfig:
     min_sample_weight: float = 1e-4
     # samples whose weight, guessed before the field pass from the up-sampling's SDF at the
     # section ends (neural3d.rendering.neus.edge_alpha), is at most this are not evaluated
-    # at all (no SDF gradient, no eikonal term: transparent); 0 = evaluate every sample
-    min_estimated_weight: float = 0.0
+    # at all (no SDF gradient, no eikonal term: transparent); 0 = evaluate every sample.
+    # On in fast: about half the samples late in training, 0.7-0.85x the training time
+    # (docs/decisions.md, 2026-11-27 "samples guessed light")
+    min_estimated_weight: float = 1e-4
     cos_anneal_steps: int = 0  # NeuS cos-anneal length; 0 = no annealing
     rgb_weight: float = 1.0
     eikonal_weight: float = 0.1
@@ -141,7 +143,8 @@ def preset_config(name: PresetName) -> TrainConfig:
                               colour_layers=4, init_inv_s=7.4),
             iterations=100_000, rays_per_batch=2048, lr=5e-4, warmup=5000,
             samples_uniform=64, samples_importance=64, upsample_steps=4,
-            min_sample_weight=0.0, cos_anneal_steps=50_000, mask_weight=0.0, ema_decay=0.0,
+            min_sample_weight=0.0, min_estimated_weight=0.0, cos_anneal_steps=50_000,
+            mask_weight=0.0, ema_decay=0.0,
             eval_every=5000, checkpoint_every=5000,
         )
     if name == "fast":
