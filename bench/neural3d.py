@@ -29,7 +29,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 # Run as a script, this file's folder is sys.path[0]: put the repository root there instead.
@@ -55,11 +55,31 @@ WWR_TARGET_PCT = 5.0
 IOU_TARGET = 0.96
 
 
-def training_steps(scene_dir: Path, config: TrainConfig, device: torch.device
-                   ) -> Callable[[int], None]:
-    """``step(i)``: training step ``i`` (``train_step``, weight averaging included) of a fresh
-    field on ``scene_dir``'s train frames, as ``neural3d.train`` runs it; synchronised on CUDA.
-    """
+@dataclass
+class TrainingState:
+    """A fresh field on a scene's train frames and everything its training steps need."""
+
+    field: torch.nn.Module
+    optimizer: torch.optim.Optimizer
+    scheduler: torch.optim.lr_scheduler.LRScheduler
+    pixels: object  # neural3d.training.data.Pixels
+    box_min: torch.Tensor  # "(3,)" normalised frame
+    box_max: torch.Tensor
+    background_class: int
+    generator: torch.Generator
+    occupancy: object  # neural3d.rendering.occupancy.OccupancyGrid | None
+    average: torch.nn.Module | None
+    config: TrainConfig
+
+    def step(self, i: int) -> None:
+        """Training step ``i`` (``train_step``, weight averaging included)."""
+        train_step(self.field, self.optimizer, self.scheduler, self.pixels, self.box_min,
+                   self.box_max, self.config, step=i, background_class=self.background_class,
+                   generator=self.generator, occupancy=self.occupancy, average=self.average)
+
+
+def training_state(scene_dir: Path, config: TrainConfig, device: torch.device) -> TrainingState:
+    """A fresh field on ``scene_dir``'s train frames, set up as ``neural3d.train`` sets it up."""
     scene = read_method_input(scene_dir)  # never the truth, as in neural3d.train
     bg = background_class(scene)
     frames = load_frames(scene, "train", image_scale=config.image_scale)
@@ -72,12 +92,20 @@ def training_steps(scene_dir: Path, config: TrainConfig, device: torch.device
     average = copy.deepcopy(field).requires_grad_(False) if config.ema_decay > 0 else None
     lo = torch.tensor(norm.box_min_unit, dtype=torch.float32, device=device)
     hi = torch.tensor(norm.box_max_unit, dtype=torch.float32, device=device)
-    gen = torch.Generator(device=device).manual_seed(config.seed)
-    occupancy = make_occupancy(config, lo, hi)
+    return TrainingState(field, optimizer, scheduler, px, lo, hi, bg,
+                         torch.Generator(device=device).manual_seed(config.seed),
+                         make_occupancy(config, lo, hi), average, config)
+
+
+def training_steps(scene_dir: Path, config: TrainConfig, device: torch.device
+                   ) -> Callable[[int], None]:
+    """``step(i)``: training step ``i`` (``train_step``, weight averaging included) of a fresh
+    field on ``scene_dir``'s train frames, as ``neural3d.train`` runs it; synchronised on CUDA.
+    """
+    state = training_state(scene_dir, config, device)
 
     def step(i: int) -> None:
-        train_step(field, optimizer, scheduler, px, lo, hi, config, step=i,
-                   background_class=bg, generator=gen, occupancy=occupancy, average=average)
+        state.step(i)
         if device.type == "cuda":
             torch.cuda.synchronize(device)
 
