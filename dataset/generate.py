@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import shutil
 import signal
-import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -24,7 +23,7 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
 from dataset.executors.ray_tasks import RayConfig, add_executor_arguments
 from dataset.executors.worker_pool import worker_pool
@@ -294,4 +293,4 @@ def _check_resources(args: argparse.Namespace, config: GenerateConfig, buildings
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

@@ -10,10 +10,9 @@ import options (:mod:`dataset.source_args`) and the same import
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.mesh import write_labelled_ply
 from dataset.core.truth import write_building
 from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE
@@ -60,4 +59,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

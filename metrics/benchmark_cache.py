@@ -23,7 +23,7 @@ class DefaultBenchmark:
     resolution: int = 128
     views: int = 40
     workers: int = 2
-    expected_minutes: float = 6.0
+    expected_minutes: float = 4.5
 
     @property
     def folder(self) -> Path:

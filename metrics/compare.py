@@ -28,7 +28,7 @@ from functools import partial
 from pathlib import Path
 
 from dataset.core.atomic import write_json_atomic, write_text_atomic
-from dataset.core.cli_errors import check_output_folder, run_cli
+from dataset.core.cli_errors import check_output_folder, exit_cli, run_cli
 from dataset.core.method import available_methods
 from dataset.core.results import code_version
 from dataset.core.truth import BuildingTruth, read_building
@@ -355,5 +355,5 @@ def _prepare(request: CompareRequest, comparisons: int = 1,
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())
 

@@ -20,7 +20,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from dataset.core.atomic import atomic_directory, write_json_atomic, write_text_atomic
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.footprint import geojson_to_polygon
 from dataset.core.orientation import true_north_xy_from_world
 from dataset.core.results import MethodResult, code_version, read_result
@@ -267,4 +267,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

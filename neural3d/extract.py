@@ -18,7 +18,6 @@ ground truth is read. Evaluation pairs them with the truth's facades
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from dataclasses import asdict
 from pathlib import Path
@@ -28,7 +27,7 @@ import torch
 
 from dataset.core.atomic import write_json_atomic
 from dataset.core.classes import NUM_CLASSES, class_id_from_name
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.device import resolve_device
 from dataset.core.footprint import polygon_to_geojson
 from dataset.core.protocols import TRAIN_PROTOCOL
@@ -301,4 +300,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import copy
 import signal
-import sys
 import threading
 import time
 from collections.abc import Callable
@@ -24,7 +23,7 @@ from tqdm import tqdm
 
 from dataset.core.atomic import write_json_atomic
 from dataset.core.classes import CLASS_NAMES
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.device import resolve_device
 from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from dataset.core.resources import check_training_resources
@@ -271,4 +270,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

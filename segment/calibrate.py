@@ -18,7 +18,6 @@ before and after.
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -29,7 +28,7 @@ import torch
 from tqdm import tqdm
 
 from dataset.core.classes import NUM_CLASSES, SemanticClass
-from dataset.core.cli_errors import add_debug_flag, run_cli
+from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
 from segment.evaluate import evenly_spaced
 from segment.network import UNet
 from segment.segmenter import predict_logits
@@ -183,4 +182,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

@@ -9,7 +9,6 @@ exact masks, pooled over the frames (intersection and union summed before dividi
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +19,7 @@ from tqdm import tqdm
 
 from dataset.core.atomic import write_text_atomic
 from dataset.core.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
-from dataset.core.cli_errors import add_debug_flag, run_cli
+from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
 from dataset.core.scene_record import Scene
 from dataset.scenes.images import read_rgb
 from dataset.scenes.scene import read_scene
@@ -177,4 +176,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

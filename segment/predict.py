@@ -9,13 +9,12 @@ reuses copies made by the same segmenter from the same scenes.
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 from tqdm import tqdm
 
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from segment.scene_masks import predicted_scene, scene_folders
 from segment.segmenter import resolve_segmenter
 
@@ -58,4 +57,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

@@ -12,7 +12,6 @@ fingerprints, libraries, wall time) atomically. Ctrl-C writes nothing.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
@@ -26,7 +25,7 @@ from torch.nn import functional as F
 from tqdm import tqdm
 
 from dataset.core.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, run_cli
+from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.provenance import make_provenance
 from segment.augment import IGNORE_LABEL, AugmentConfig
 from segment.evaluate import confusion_matrix, evenly_spaced, iou_per_class, mean_iou
@@ -275,4 +274,4 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    exit_cli(main())

@@ -18,6 +18,7 @@ at the end (:mod:`dataset.core.warnings_summary`), never once per face or frame.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import warnings
 from collections.abc import Callable
@@ -75,6 +76,17 @@ def run_cli(prog: str, body: Callable[[], int], *, debug: bool = False,
         finally:
             for line in summarise_warnings([str(w.message) for w in caught]):
                 print(f"warning: {line}", file=sys.stderr)
+
+
+def exit_cli(code: int) -> None:
+    """Exit a command line with ``code`` (its ``__main__``: ``exit_cli(main())``).
+
+    The work is done and written by now, so Ctrl-C is ignored from here on: during the
+    interpreter's shutdown it would kill the process with no word (exit -2) or a stray
+    traceback, and a finished run would look interrupted.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sys.exit(code)
 
 
 def check_output_folder(folder: str | Path, flag: str = "--out") -> Path:
