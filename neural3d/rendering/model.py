@@ -93,9 +93,8 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
             weights = weights * heavy
             heavy = heavy.reshape(-1) if evaluated is None else heavy.reshape(-1)[evaluated]
             kept = torch.nonzero(heavy).squeeze(1)
-    rgb = _on_all_samples(_at_samples(field.colour, kept, pts, dirs_s, grad, feature),
-                          evaluated, n_all)
-    logits = _on_all_samples(_at_samples(field.semantic_logits, kept, feature), evaluated, n_all)
+    rgb = _at_samples(field.colour, kept, evaluated, n_all, pts, dirs_s, grad, feature)
+    logits = _at_samples(field.semantic_logits, kept, evaluated, n_all, feature)
     with record_function("neural3d.compositing"):
         rgb = rgb.reshape(n_rays, n_samples, 3)
         logits = logits.reshape(n_rays, n_samples, field.num_classes)
@@ -122,10 +121,13 @@ def _on_all_samples(values: Tensor, rows: Tensor | None, n_all: int) -> Tensor:
     return values.new_zeros(n_all, *values.shape[1:]).index_copy(0, rows, values)
 
 
-def _at_samples(head, kept: Tensor | None, *inputs: Tensor) -> Tensor:
-    """``head(*inputs)`` "(M, D)" at every sample, evaluated only at the ``kept`` rows (zeros
-    elsewhere, where the weight is 0); every row when ``kept`` is None."""
-    if kept is None:
-        return head(*inputs)
-    out = head(*(x[kept] for x in inputs))
-    return out.new_zeros(len(inputs[0]), out.shape[1]).index_copy(0, kept, out)
+def _at_samples(head, kept: Tensor | None, evaluated: Tensor | None, n_all: int,
+                *inputs: Tensor) -> Tensor:
+    """``head(*inputs)`` "(n_all, D)" at every ray sample, zeros where the weight is 0.
+
+    ``inputs`` "(M, ...)" are at the ``evaluated`` samples (all when None); the head runs
+    only on their ``kept`` rows (all when None).
+    """
+    out = head(*inputs) if kept is None else head(*(x[kept] for x in inputs))
+    rows = kept if evaluated is None else (evaluated if kept is None else evaluated[kept])
+    return _on_all_samples(out, rows, n_all)

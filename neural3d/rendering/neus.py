@@ -23,9 +23,7 @@ def neus_alpha(sdf: Tensor, cos_dir_normal: Tensor, section_lengths: Tensor, inv
     """
     cos = -(torch.relu(-cos_dir_normal * 0.5 + 0.5) * (1.0 - cos_anneal_ratio)
             + torch.relu(-cos_dir_normal) * cos_anneal_ratio)
-    prev_cdf = torch.sigmoid((sdf - cos * section_lengths * 0.5) * inv_s)
-    next_cdf = torch.sigmoid((sdf + cos * section_lengths * 0.5) * inv_s)
-    return ((prev_cdf - next_cdf + 1e-5) / (prev_cdf + 1e-5)).clamp(0.0, 1.0)
+    return _cdf_drop(sdf - cos * section_lengths * 0.5, sdf + cos * section_lengths * 0.5, inv_s)
 
 
 def edge_alpha(sdf_edges: Tensor, inv_s: Tensor | float) -> Tensor:
@@ -35,8 +33,14 @@ def edge_alpha(sdf_edges: Tensor, inv_s: Tensor | float) -> Tensor:
     sharpness ``inv_s`` between a section's ends. Used to guess which sections will
     weigh anything before the field is evaluated with its gradient.
     """
-    prev_cdf = torch.sigmoid(sdf_edges[:, :-1] * inv_s)
-    next_cdf = torch.sigmoid(sdf_edges[:, 1:] * inv_s)
+    return _cdf_drop(sdf_edges[:, :-1], sdf_edges[:, 1:], inv_s)
+
+
+def _cdf_drop(sdf_start: Tensor, sdf_end: Tensor, inv_s: Tensor | float) -> Tensor:
+    """Opacity of sections from the SDF at their start and end (any same shape): the relative
+    drop of the logistic CDF of sharpness ``inv_s`` across each, in [0, 1]."""
+    prev_cdf = torch.sigmoid(sdf_start * inv_s)
+    next_cdf = torch.sigmoid(sdf_end * inv_s)
     return ((prev_cdf - next_cdf + 1e-5) / (prev_cdf + 1e-5)).clamp(0.0, 1.0)
 
 
