@@ -36,7 +36,7 @@ from neural3d.extract import semantic_mesh_of_field  # noqa: E402
 from neural3d.extraction.extract_config import ExtractConfig  # noqa: E402
 from neural3d.extraction.measure import measure_semantic_mesh  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
-from neural3d.method import RUNS_FOLDER  # noqa: E402
+from neural3d.method import RUNS_FOLDER, trained_runs  # noqa: E402
 
 SPLITS = ("labels", "probabilities")
 
@@ -99,9 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", type=Path, default=None, help="also write the figures here")
     args = parser.parse_args(argv)
     torch.set_num_threads(args.threads)
-    runs = sorted(p for p in (args.results / RUNS_FOLDER).iterdir()
-                  if (p / "checkpoint.pt").is_file()
-                  and (args.scenes is None or p.name in args.scenes))
+    runs = trained_runs(args.results, args.scenes)
     if not runs:
         parser.error(f"no trained runs in {args.results / RUNS_FOLDER}")
     extract = ExtractConfig(resolution=args.resolution)

@@ -48,7 +48,7 @@ from neural3d.extract import measure_mesh, semantic_mesh_of_field  # noqa: E402
 from neural3d.extraction.extract_config import STAGES, ExtractConfig, without_stages  # noqa: E402
 from neural3d.extraction.meshing import SemanticMesh  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
-from neural3d.method import RUNS_FOLDER  # noqa: E402
+from neural3d.method import RUNS_FOLDER, trained_runs  # noqa: E402
 
 ALL = "all"
 MEASURED = ("wwr", "window_area_m2", "facade_area_m2", "facades", "footprint", "warnings")
@@ -218,11 +218,9 @@ def main(argv: list[str] | None = None) -> int:
         sets = stage_sets(args.without)
     except ValueError as exc:
         parser.error(str(exc))
-    runs_dir = args.results / RUNS_FOLDER
-    runs = sorted(p for p in runs_dir.iterdir() if (p / "checkpoint.pt").is_file()
-                  and (args.scenes is None or p.name in args.scenes)) if runs_dir.is_dir() else []
+    runs = trained_runs(args.results, args.scenes)
     if not runs:
-        parser.error(f"no trained runs in {runs_dir}")
+        parser.error(f"no trained runs in {args.results / RUNS_FOLDER}")
     saved = None
     if args.compare_to is not None:
         try:

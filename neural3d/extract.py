@@ -6,7 +6,8 @@
   head, mapped to :mod:`dataset.core.classes` ids by the run's class names) and RGB
   from the colour network looking at the surface head-on (view direction =
   -vertex normal, so the colour does not depend on where a camera happened to be);
-- ``footprint.geojson``: zero contour of the SDF averaged over ``footprint_heights_m``;
+- ``footprint.geojson``: zero contour of the SDF averaged over ``footprint_heights_m``,
+  its straight runs straightened (:mod:`neural3d.extraction.straight_walls`);
 - ``<scene>__neural3d__train.json``: the :class:`dataset.core.results.MethodResult`.
 
 Facades are the mesh's own facade groups (:mod:`neural3d.extraction.measure`), numbered
@@ -51,6 +52,7 @@ from neural3d.extraction.meshing import (
     color_vertices,
     extract_mesh,
 )
+from neural3d.extraction.straight_walls import straighten_footprint
 
 METHOD = "neural3d"
 PROTOCOL = TRAIN_PROTOCOL
@@ -176,6 +178,9 @@ def measure_mesh(trained, mesh: SemanticMesh, config: ExtractConfig, *, device: 
             cell_m=footprint_cell_m(trained.box_min_m, trained.box_max_m, config),
             min_area_m2=config.footprint_min_area_m2, roofed_hole_fill=config.roofed_hole_fill,
         )
+        if config.straight_walls:
+            polygon = straighten_footprint(polygon, tolerance_m=config.footprint_wall_tolerance_m,
+                                           min_wall_m=config.footprint_min_wall_m)
         footprint = polygon_to_geojson(polygon)
     except ValueError as exc:
         footprint = None

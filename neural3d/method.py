@@ -93,6 +93,17 @@ OPTIONS = (
 SHORT_RUN = {"steps": 2000, "resolution": 128, "eval_frames": 1, "threads": 1}
 
 
+def trained_runs(results_dir: Path, scenes: list[str] | None = None) -> list[Path]:
+    """The run folders a comparison kept under ``results_dir / RUNS_FOLDER`` that hold a
+    trained field (``checkpoint.pt``), sorted; only ``scenes`` when given. Empty when
+    there is no such folder."""
+    runs_dir = Path(results_dir) / RUNS_FOLDER
+    if not runs_dir.is_dir():
+        return []
+    return sorted(p for p in runs_dir.iterdir() if (p / "checkpoint.pt").is_file()
+                  and (scenes is None or p.name in scenes))
+
+
 def check_budget(budget: Neural3dBudget, runs_here: bool) -> None:
     """Refuse a device that is not a torch CPU/CUDA device, or (``runs_here``) not here."""
     from dataset.core.device import resolve_device

@@ -208,9 +208,10 @@ def test_switches_that_need_another_stage_are_refused_and_without_turns_them_off
 
 
 def test_extract_config_switches_every_stage():
-    assert STAGES[-1] == "roofed_hole_fill" and len(STAGES) == 9
+    assert STAGES[-2:] == ("roofed_hole_fill", "straight_walls") and len(STAGES) == 10
     config = without_stages(ExtractConfig(), "roofed_hole_fill", "occluded_fill")
     assert not config.roofed_hole_fill and not config.measure.stages.occluded_fill
+    assert config.straight_walls
     assert config.measure.stages.concave_corner_fill
     assert without_stages(ExtractConfig()) == ExtractConfig()
     with pytest.raises(ValueError, match="unknown stage"):
