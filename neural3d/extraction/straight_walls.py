@@ -18,8 +18,8 @@ What it assumes, and where it biases: a run the simplification keeps within
 becomes a polygon whose sides stray up to about ``tolerance_m`` from it (a
 circle of radius 5 m keeps an IoU above 0.99 with itself); a corner the field
 rounds by more than ``tolerance_m`` (a radius above about 0.36 m) keeps part of
-its rounding as a short run. A ring whose straightened form is not a valid
-polygon keeps its points.
+its rounding as a short run. A piece (a polygon with its holes) whose
+straightened form is not a valid polygon keeps its points.
 """
 
 from __future__ import annotations
