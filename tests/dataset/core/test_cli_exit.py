@@ -12,6 +12,8 @@ from paths import REPO_ROOT
 SCRIPT = """
 import atexit, os, signal, time
 from dataset.core.cli_errors import exit_cli
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as from a terminal, even when
+# the test runs in the background, where the shell hands children SIGINT ignored
 atexit.register(lambda: (os.kill(os.getpid(), signal.SIGINT), time.sleep(0.2)))
 print("done", flush=True)
 {exit}
