@@ -11,9 +11,10 @@ as the extraction takes it before its last stage
 is half its voxel), then straightened
 (:func:`neural3d.extraction.straight_walls.straighten_footprint`) with every
 pair of ``--tolerances`` x ``--min-walls``. Prints, in Markdown, the footprint
-IoU against the truth per building (the contour as is, then each pair) and per
-family: the mean, the lowest, and how many buildings each pair makes worse by
-more than 0.001. Only the SDF on the footprint planes is queried: no mesh.
+IoU against the truth (as a comparison computes it, from the GeoJSON) per
+building (the contour as is, then each pair) and per family: the mean, the
+lowest, and how many buildings each pair makes worse by more than 0.001. Only
+the SDF on the footprint planes is queried: no mesh.
 """
 
 from __future__ import annotations
@@ -29,9 +30,9 @@ if not __package__:
     sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
-from shapely.geometry import shape  # noqa: E402
 
 from dataset.core.atomic import write_json_atomic  # noqa: E402
+from dataset.core.footprint import geojson_to_polygon, polygon_to_geojson  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
 from metrics.errors import footprint_iou  # noqa: E402
@@ -68,13 +69,19 @@ def building_ious(run_dir: Path, extract: ExtractConfig,
         heights_m=footprint_heights_m(field.box_max_m, extract),
         cell_m=footprint_cell_m(field.box_min_m, field.box_max_m, extract),
         min_area_m2=extract.footprint_min_area_m2, roofed_hole_fill=extract.roofed_hole_fill)
-    true_polygon = shape(truth.footprint)
-    ious = {CONTOUR: footprint_iou(contour, true_polygon)}
+    true_polygon = geojson_to_polygon(truth.footprint)
+    ious = {CONTOUR: footprint_iou(_as_written(contour), true_polygon)}
     for tolerance_m, min_wall_m in pairs:
         straight = straighten_footprint(contour, tolerance_m=tolerance_m, min_wall_m=min_wall_m)
-        ious[pair_label(tolerance_m, min_wall_m)] = footprint_iou(straight, true_polygon)
+        ious[pair_label(tolerance_m, min_wall_m)] = footprint_iou(_as_written(straight),
+                                                                 true_polygon)
     print(f"  {run_dir.name}: contour {ious[CONTOUR]:.4f}", file=sys.stderr, flush=True)
     return {"scene": run_dir.name, "family": truth.type, "iou": ious}
+
+
+def _as_written(polygon):
+    """The footprint as a comparison reads it back from the result's GeoJSON."""
+    return geojson_to_polygon(polygon_to_geojson(polygon))
 
 
 def markdown(buildings: list[dict]) -> str:

@@ -31,6 +31,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from shapely.geometry import MultiPolygon, Polygon
+from shapely.ops import unary_union
 
 from neural3d.extraction.meshing import SdfFn, check_box, evaluate_points
 
@@ -135,7 +136,8 @@ def fill_roofed_holes(
     it (its representative point if the grid has none), one SDF sample per ``cell_m``; a
     line meets a surface where a sample is inside or within ``cell_m / 2`` of one.
     Holes where more than half the lines meet a surface are filled; the others
-    (courtyards open to the sky) stay.
+    (courtyards open to the sky) stay. A piece that stood inside a filled hole merges
+    with the piece around it, so the result is a valid (Multi)Polygon.
     """
     zs = np.arange(z_from_m, z_to_m + 1e-9, cell_m)
     if len(zs) == 0:
@@ -145,7 +147,9 @@ def fill_roofed_holes(
         holes = [ring for ring in piece.interiors
                  if not _roofed(Polygon(ring), sdf_fn, zs, cell_m)]
         pieces.append(Polygon(piece.exterior, holes))
-    return pieces[0] if len(pieces) == 1 else MultiPolygon(pieces)
+    # a piece that stood in a filled hole (a pillar in a pocket) now lies inside its filler
+    merged = unary_union(pieces)
+    return merged if isinstance(merged, Polygon | MultiPolygon) else MultiPolygon(pieces)
 
 
 def _roofed(hole: Polygon, sdf_fn: SdfFn, zs: np.ndarray, cell_m: float) -> bool:

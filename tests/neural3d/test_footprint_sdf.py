@@ -70,6 +70,23 @@ def test_roofed_pocket_is_filled_and_courtyard_kept():
     assert kept.area == pytest.approx(144 - 4, rel=0.01)
 
 
+def test_a_pillar_in_a_filled_pocket_merges_into_the_footprint():
+    """The contour cuts the pocket as a hole and the pillar standing in it as a piece of its
+    own; once the roofed pocket is filled, the pillar lies inside the footprint: one valid
+    polygon, not two overlapping pieces."""
+    def pocket_with_pillar(p):
+        walls = np.maximum(box_sdf(p, [0, 0, 0], [12, 12, 8]),
+                           -box_sdf(p, [3, 3, 0.2], [9, 9, 3]))
+        return np.minimum(walls, box_sdf(p, [5, 5, 0], [7, 7, 8]))
+
+    poly = _footprint(pocket_with_pillar)
+    assert isinstance(poly, Polygon) and poly.is_valid and len(poly.interiors) == 0
+    assert poly.area == pytest.approx(144, rel=0.01)
+    unfilled = _footprint(pocket_with_pillar, roofed_hole_fill=False)
+    assert isinstance(unfilled, MultiPolygon) and len(unfilled.geoms) == 2
+    assert unfilled.area == pytest.approx(144 - 36 + 4, rel=0.01)
+
+
 def test_separate_pieces_and_slivers():
     def sdf(p):
         return np.minimum.reduce([box_sdf(p, [0, 0, 0], [4, 4, 8]),
