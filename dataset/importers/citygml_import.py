@@ -294,6 +294,7 @@ def _uncovered_record(f: FacadeRegions, surfaces: list[Surface], north_deg: floa
             "normal": [float(x) for x in f.normal],
             "wall_area_m2": float(f.wall.area), "width_m": float(f.gross.bounds[2]
                                                                   - f.gross.bounds[0]),
+            "outline_m": [[float(x) for x in corner] for corner in f.outline_m()],
             "wall_polygon_ids": [surfaces[i].polygon_id for i in f.surfaces]}
 
 
