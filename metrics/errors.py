@@ -22,14 +22,14 @@ from shapely.ops import unary_union
 from dataset.core.footprint import geojson_to_polygon
 from dataset.core.results import MethodResult
 from dataset.core.truth import BuildingTruth
-from metrics.covered_facades import facade_distance_limit_m, over_truth_facades
-from metrics.facade_match import has_facade_geometry, match_facades
+from metrics.facade_scoring import pair_facades, score_result
 
 Status = Literal["ok", "failed"]
+FacadeKind = Literal["matched", "missed", "false_positive"]
 CUT_SHORT = "cut short"  # mark: a safety time cap stopped the run before its step budget
 STALE = "stale"  # mark: made by other code or settings, kept with --reuse-stale
 NO_TRUTH_FAMILY = "unknown"  # family of a scene without building.json (a user's photos)
-LEFT_OUT_FACADE_ID = 0  # facade id of a row for an estimate that faces no truth facade
+LEFT_OUT_FACADE_ID = 0  # facade id of a row for an estimate on no truth facade (false positive)
 
 
 def absolute_percentage_error(estimate: float, truth: float) -> float:
@@ -125,7 +125,14 @@ class RunTiming:
 
 @dataclass(frozen=True)
 class FacadeErrors:
-    """One facade of one (scene, method, protocol); APE in %, ``None`` where not estimated."""
+    """One facade of one (scene, method, protocol); APE in %, ``None`` where not estimated.
+
+    ``kind`` (:mod:`metrics.facade_scoring`): ``"matched"``, a truth facade with an estimate;
+    ``"missed"``, a truth facade without one (``status`` failed); ``"false_positive"``, an
+    estimate on no wall of the truth (facade id :data:`LEFT_OUT_FACADE_ID`, ``status``
+    failed, its estimate's ``facade_est_m2``). ``wwr_est``/``wwr_true`` are fractions; the
+    error in WWR points is ``100 * |wwr_est - wwr_true|`` (:attr:`wwr_points`).
+    """
 
     scene: str
     family: str
@@ -139,6 +146,15 @@ class FacadeErrors:
     wwr_ape: float | None = None
     window_ape: float | None = None
     facade_ape: float | None = None
+    kind: FacadeKind = "matched"
+    facade_est_m2: float | None = None
+
+    @property
+    def wwr_points(self) -> float | None:
+        """Absolute WWR error in percentage points; ``None`` without both WWRs."""
+        if self.wwr_est is None or self.wwr_true is None:
+            return None
+        return 100.0 * abs(self.wwr_est - self.wwr_true)
 
 
 def failed_building(
@@ -159,16 +175,19 @@ def building_errors(
     """Errors of one result against its building's truth (``None``: estimates only).
 
     ``stale``: the result was kept although made by other code or settings.
-    Against a truth that counts only some walls (CityGML's covered facades) a result's
-    own facades count only where they lie on those (:mod:`metrics.covered_facades`),
-    and the reason says so. A result without a WWR counts as failed, with its warnings
+    The building figures are the ones the scoring rule charges (:mod:`metrics.facade_scoring`:
+    what lies on walls the truth does not count is left out, false positives count), and
+    the reason says what was left out. A result without a WWR counts as failed, with its warnings
     as the reason. A footprint that cannot be compared (malformed GeoJSON) gives IoU ``None``
     and a reason, but does not fail the WWR figures.
     """
     family = truth.type if truth is not None else NO_TRUTH_FAMILY
     marks = result_marks(result, stale=stale)
-    result, covered_note = over_truth_facades(result, truth) if truth is not None else (
-        result, "")
+    if truth is not None:
+        scored = score_result(result, truth)
+        result, covered_note = scored.result, scored.note
+    else:
+        covered_note = ""
     if result.wwr is None or not math.isfinite(result.wwr):
         reason = "; ".join(result.warnings) or "the method produced no WWR"
         return replace(failed_building(result.scene, family, result.method, result.protocol,
@@ -230,51 +249,42 @@ def visible_errors(result: MethodResult, truth: BuildingTruth | None) -> dict[st
 
 
 def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[FacadeErrors, ...]:
-    """Per-facade errors of a result, one row per truth facade the result names.
-
-    Under the ideal and multi protocols the result's facade ids are the truth's
-    (each view carries its facade id). Other results (a mesh's facades) number their
-    own facades; when every estimate carries ``normal`` and ``centre_m`` they
-    are matched to the truth's facades by :func:`metrics.facade_match.match_facades`
-    (only those on a covered facade where the truth counts only some walls), and each
-    estimate that faces no truth facade gives a failed row with facade id
-    ``LEFT_OUT_FACADE_ID`` (0) and the reason. Otherwise: no rows.
+    """Per-facade rows of a result under the one scoring rule (:mod:`metrics.facade_scoring`):
+    one per truth facade (matched or missed) and one per false-positive estimate; none
+    where there is no truth or the result's facades cannot be paired (own ids without
+    locations). A malformed result file fails its facades, not the run.
     """
     if truth is None:
         return ()
     base = (result.scene, truth.type, result.method, result.protocol)
-    if result.facade_identity == "truth_id":
-        estimates, left_out = result.facades, ()
-    elif has_facade_geometry(result.facades):
-        try:
-            match = match_facades(result.facades, truth,
-                                  max_distance_m=facade_distance_limit_m(truth))
-        except ValueError as exc:  # a malformed result file fails its facades, not the run
-            return (FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=str(exc)),)
-        estimates, left_out = match.facades, match.left_out
-    else:
+    try:
+        match = pair_facades(result, truth)
+    except ValueError as exc:
+        return (FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=str(exc),
+                             kind="false_positive"),)
+    if match is None:
         return ()
     true_by_id = {f.id: f for f in truth.facades}
     rows = []
-    for est in estimates:
-        true = true_by_id.get(est.id)
-        if true is None:
-            rows.append(FacadeErrors(*base, est.id, status="failed",
-                                     reason="no such facade in the truth"))
-        elif est.missing or est.wwr is None:
-            rows.append(FacadeErrors(*base, est.id, status="failed",
-                                     reason=est.reason or "missing"))
-        else:
-            notes: list[str] = []
-            wwr_ape = _ape_or_none(est.wwr, true.wwr, notes, "WWR")
-            window_ape = _ape_or_none(est.window_area_m2, true.window_area_m2, notes, "window")
-            facade_ape = _ape_or_none(est.facade_area_m2, true.facade_area_m2, notes, "facade")
-            rows.append(FacadeErrors(
-                *base, est.id, reason="; ".join(notes), wwr_est=est.wwr, wwr_true=true.wwr,
-                wwr_ape=wwr_ape, window_ape=window_ape, facade_ape=facade_ape,
-            ))
-    rows.extend(FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=reason)
-                for _, reason in left_out)
+    for est in match.facades:
+        true = true_by_id[est.id]
+        if est.missing or est.wwr is None:
+            rows.append(FacadeErrors(*base, est.id, status="failed", wwr_true=true.wwr,
+                                     reason=est.reason or "missing", kind="missed"))
+            continue
+        notes: list[str] = []
+        wwr_ape = _ape_or_none(est.wwr, true.wwr, notes, "WWR")
+        window_ape = _ape_or_none(est.window_area_m2, true.window_area_m2, notes, "window")
+        facade_ape = _ape_or_none(est.facade_area_m2, true.facade_area_m2, notes, "facade")
+        rows.append(FacadeErrors(
+            *base, est.id, reason="; ".join(notes), wwr_est=est.wwr, wwr_true=true.wwr,
+            wwr_ape=wwr_ape, window_ape=window_ape, facade_ape=facade_ape,
+            facade_est_m2=est.facade_area_m2,
+        ))
+    rows.extend(FacadeErrors(*base, LEFT_OUT_FACADE_ID, status="failed", reason=u.reason,
+                             wwr_est=u.estimate.wwr, kind="false_positive",
+                             facade_est_m2=u.estimate.facade_area_m2)
+                for u in match.false_positives)
     return tuple(rows)
 
 

@@ -31,8 +31,7 @@ from dataset.core.orientation import (
 from dataset.core.results import FacadeEstimate, MethodResult
 from dataset.core.truth import BuildingTruth
 from dataset.core.wwr import wwr_from_areas
-from metrics.covered_facades import facade_distance_limit_m
-from metrics.facade_match import has_facade_geometry, match_facades
+from metrics.facade_scoring import pair_facades
 
 TRUTH_METHOD = "truth"  # the method name of the truth's own rows
 AzimuthFrom = Literal["truth normal", "estimate normal", "truth facade", ""]
@@ -168,27 +167,18 @@ def orientation_rows(rows: Sequence[FacadeRow]) -> tuple[OrientationRow, ...]:
 
 def estimates_by_truth_facade(result: MethodResult, truth: BuildingTruth
                               ) -> tuple[FacadeEstimate, ...] | None:
-    """The result's figures on the truth's facade ids (one per truth facade, in its order).
+    """The result's figures on the truth's facade ids (one per truth facade, in its order),
+    paired by the one scoring rule (:func:`metrics.facade_scoring.pair_facades`).
 
-    Results on ideal / multi views carry the truth's ids; results that locate
-    their own facades are matched (:func:`metrics.facade_match.match_facades`; only those on
-    a covered facade where the truth counts only some walls, :mod:`metrics.covered_facades`).
-    ``None`` when the result has no per-facade figures, neither applies or the match fails.
+    ``None`` when the result has no per-facade figures, cannot be paired or the pairing fails.
     """
     if not result.facades:
         return None
-    if result.facade_identity == "truth_id":
-        by_id = {e.id: e for e in result.facades}
-        return tuple(by_id.get(f.id, FacadeEstimate(id=f.id, wwr=None, missing=True,
-                                                    reason="not in the result"))
-                     for f in truth.facades)
-    if not has_facade_geometry(result.facades):
-        return None
     try:
-        return match_facades(result.facades, truth,
-                             max_distance_m=facade_distance_limit_m(truth)).facades
+        match = pair_facades(result, truth)
     except ValueError:
         return None
+    return None if match is None else match.facades
 
 
 def _summed_areas(known: Sequence[FacadeRow]) -> dict[str, float | None]:

@@ -136,6 +136,33 @@ class BuildingTruth:
         window, wall, door = (float(sum(p[k] for p in parts)) for k in range(3))
         return ClassAreas(window_m2=window, wall_m2=wall, door_m2=door)
 
+    @property
+    def counts_every_wall(self) -> bool:
+        """Whether the truth's facades are all of the building's walls (``False``: a CityGML
+        model whose uncovered walls, backyard and party walls, are listed apart)."""
+        return not self.extra.get("uncovered_facades")
+
+    @property
+    def uncovered_outlines_m(self) -> tuple[tuple[tuple[float, float, float], ...], ...]:
+        """World-frame outlines, (n, 3) corners in m, of the walls the truth lists apart and
+        does not count (``extra["uncovered_facades"]``); empty where it counts every wall.
+
+        Raises
+        ------
+        ValueError
+            If an uncovered wall's record has no outline (a scene written before they were
+            kept: regenerate it).
+        """
+        out = []
+        for k, record in enumerate(self.extra.get("uncovered_facades", ())):
+            if "outline_m" not in record:
+                raise ValueError(
+                    f"building {self.id}: uncovered wall {k} has no outline_m (the scene was "
+                    "written before uncovered walls kept their outlines); regenerate it with "
+                    "`python -m dataset.generate`")
+            out.append(tuple(tuple(float(x) for x in corner) for corner in record["outline_m"]))
+        return tuple(out)
+
     def facade(self, facade_id: int) -> FacadeTruth:
         """The facade with id ``facade_id``."""
         for f in self.facades:

@@ -123,8 +123,9 @@ def test_facade_errors_missing_unknown_and_unmatched_protocol():
                *result.facades[1:])
     rows = facade_errors(replace(result, facades=facades), make_truth("a"))
     assert [(r.facade_id, r.status, r.reason) for r in rows] == [
-        (1, "failed", "no usable view"), (2, "ok", ""), (3, "failed", "no such facade in the truth")
-    ]
+        (1, "failed", "no usable view"), (2, "ok", ""),
+        (0, "failed", "estimated facade 3: no such facade in the truth")]
+    assert [r.kind for r in rows] == ["missed", "matched", "false_positive"]
     # Facades numbered by the method itself and without normal/centre cannot be matched.
     assert facade_errors(replace(result, facade_identity="geometry"), make_truth("a")) == ()
 
@@ -146,7 +147,7 @@ def test_neural3d_facades_are_matched_to_the_truth_by_normal_and_centre():
     assert (rows[0].wwr_ape, rows[0].window_ape, rows[0].facade_ape) == pytest.approx(
         (0.0, 0.0, 0.0), abs=TOL)
     assert rows[1].reason == "no estimated facade lies on this facade"
-    assert "estimated facade 3 faces no truth facade" in rows[2].reason
+    assert "estimated facade 3 faces no wall of the truth" in rows[2].reason
     # without normal and centre the method's own ids mean nothing to the truth: no rows
     assert facade_errors(replace(result, facades=own[:2] + (replace(own[2], normal=None),)),
                          make_truth("a")) == ()

@@ -46,7 +46,8 @@ def test_parallel_walls_go_to_the_nearest_outline(l_shaped):
     estimates = (_estimate(1, (1.0, 0.0, 0.0), (1.2, 4.5, 5.0)),   # near facade 4
                  _estimate(2, (0.98, 0.2, 0.0), (6.1, -2.0, 5.0)))  # near facade 2, 11.5 deg off
     match = match_facades(estimates, l_shaped)
-    assert [f.id for f in match.facades] == [1, 2, 3, 4, 5, 6] and match.left_out == ()
+    assert [f.id for f in match.facades] == [1, 2, 3, 4, 5, 6]
+    assert match.false_positives == () and match.out_of_scope == ()
     assert [f.id for f in match.facades if not f.missing] == [2, 4]
     assert match.facades[1] == replace(estimates[1], id=2)  # one estimate: figures unchanged
     assert match.facades[3] == replace(estimates[0], id=4)
@@ -54,7 +55,7 @@ def test_parallel_walls_go_to_the_nearest_outline(l_shaped):
                for f in match.facades if f.missing)
 
 
-def test_segments_merge_and_a_stray_estimate_is_left_out(l_shaped):
+def test_segments_merge_and_a_stray_estimate_is_a_false_positive(l_shaped):
     estimates = (_estimate(1, (0.0, -1.0, 0.0), (-3.0, -6.7, 5.0), window=2.0, gross=10.0),
                  _estimate(2, (0.0, -1.0, 0.0), (3.0, -6.8, 5.0), window=4.0, gross=30.0),
                  _estimate(3, (0.0, 0.0, 1.0), (0.0, 0.0, 10.6)))  # a roof, faces no facade
@@ -65,8 +66,9 @@ def test_segments_merge_and_a_stray_estimate_is_left_out(l_shaped):
     assert merged.wwr == pytest.approx(wwr_from_areas(6.0, 34.0, 0.0), abs=TOL)
     assert (merged.width_m, merged.height_m) == (4.0, 5.0)
     assert merged.centre_m == pytest.approx((1.5, -6.775, 5.0), abs=TOL)  # area-weighted
-    assert match.left_out == ((3, "estimated facade 3 faces no truth facade "
-                                  "(normal within 45 degrees)"),)
+    assert [(u.estimate.id, u.reason) for u in match.false_positives] == [
+        (3, "estimated facade 3 faces no wall of the truth (normal within 45 degrees): a "
+            "false positive")]
 
 
 def test_merge_without_areas_is_missing_with_a_reason(l_shaped):
@@ -77,7 +79,7 @@ def test_merge_without_areas_is_missing_with_a_reason(l_shaped):
 
 
 def test_truth_without_outlines_goes_by_normal(l_shaped):
-    bare = replace(l_shaped, extra={})
+    bare = replace(l_shaped, facade_outlines_m={})
     match = match_facades((_estimate(1, (0.6, -0.8, 0.0), (0.0, 0.0, 0.0)),), bare)
     # -y (facade 1) is 37 deg away, +x (facades 2 and 4) 53 deg: only facade 1 qualifies
     assert [f.id for f in match.facades if not f.missing] == [1]
@@ -104,7 +106,7 @@ def test_curved_wall_segments_merge_into_one_facade():
     truth = replace(build_building(recipe).truth, facades=(wall,),
                     facade_outlines_m={1: outlines})
     match = match_facades(estimates, truth)
-    assert len(estimates) > 1 and match.left_out == ()
+    assert len(estimates) > 1 and match.false_positives == ()
     (whole,) = match.facades
     assert whole.facade_area_m2 == pytest.approx(sum(e.facade_area_m2 for e in estimates),
                                                  rel=TOL)
