@@ -68,6 +68,7 @@ from metrics.report import (
     table3_footprint_iou,
     timing_table,
 )
+from metrics.report_facades import FACADE_SCORES_NAME, facade_scores_table
 from metrics.report_paper import (
     PAPER_TABLE2_NAME,
     PAPER_TABLE3_NAME,
@@ -84,7 +85,8 @@ PROVENANCE_FILE = "provenance.json"
 PIPELINE_FOLDER = "2dss_pipeline"
 FOOTPRINTS_FOLDER = "footprints"
 PLOTS_FOLDER = "plots"
-CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME)
+CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME,
+                      FACADE_SCORES_NAME)
 
 
 @dataclass(frozen=True)
@@ -96,7 +98,7 @@ class Comparison:
     table2: Table
     table3: Table
     outcomes: tuple[Outcome, ...]
-    more_tables: tuple[Table, ...] = ()  # against the visible truth, seed spread, the paper's
+    more_tables: tuple[Table, ...] = ()  # visible truth, seed spread, the paper's, facade scores
 
 
 def compare(
@@ -138,7 +140,8 @@ def compare(
         table2=replace(table2, notes=(*table2.notes, footer)),
         table3=replace(table3, notes=(*table3.notes, footer)),
         outcomes=tuple(outcomes),
-        more_tables=claims_tables(groups, paper_names_of(specs)),
+        more_tables=(*claims_tables(groups, paper_names_of(specs)),
+                     *((facade_scores_table(facade_rows, groups),) if facade_rows else ())),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
     comment = f"produced by `{command}`; {footer}"
