@@ -36,6 +36,7 @@ from dataset.core.scene_record import Frame, Scene  # noqa: E402
 from dataset.rendering.render import Raycaster, render_ground_truth  # noqa: E402
 from dataset.scenes.images import write_depth_m, write_labels  # noqa: E402
 from dataset.scenes.scene import read_method_input, read_scene, write_transforms  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 
 
@@ -73,6 +74,7 @@ def main(argv: list[str] | None = None) -> int:
         if min(factors) < 1:
             raise ValueError("factors must be integers >= 1")
         config = Wwr2dssConfig(max_rectified_px=args.max_rectified_px)
+        refuse_report_only(scene_folders(args.data), "choose 2D-SS's resolution")
         folders = [f for f in scene_folders(args.data)
                    if getattr(read_scene(f).building, "type", None) == args.family]
         if not folders:

@@ -24,6 +24,7 @@ import numpy as np  # noqa: E402
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
 from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 
 
@@ -32,6 +33,10 @@ def main() -> None:
     p.add_argument("--data", type=Path, required=True)
     p.add_argument("--views", default="ideal,multi")
     args = p.parse_args()
+    try:
+        refuse_report_only(scene_folders(args.data), "choose 2D-SS's facade-area rule")
+    except ValueError as exc:
+        p.error(str(exc))
     configs = {"L x H": replace(Wwr2dssConfig(), min_rectangle_fill=0.0),
                "outline": Wwr2dssConfig()}
     totals: dict[tuple[str, str], list[tuple[float, float, float]]] = {}

@@ -38,6 +38,7 @@ from bench.neural3d import IOU_TARGET, WWR_TARGET_PCT, on_target, with_overrides
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from neural3d.config import TrainConfig, config_to_dict, preset_config  # noqa: E402
 from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint  # noqa: E402
 
@@ -175,6 +176,10 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     scenes = sorted(p for p in args.benchmark.iterdir() if (p / "transforms.json").is_file()
                     and (args.scenes is None or p.name in args.scenes))
+    try:
+        refuse_report_only(scenes, "choose a training budget")
+    except ValueError as exc:
+        parser.error(str(exc))
     if not scenes:
         print(f"error: {args.benchmark} holds no scene folder (transforms.json)", file=sys.stderr)
         return 2

@@ -40,12 +40,13 @@ from bench.neural3d import (  # noqa: E402  the targets and the spread, defined 
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 from neural3d.extract import measure_field  # noqa: E402
 from neural3d.extraction.extract_config import ExtractConfig  # noqa: E402
 from neural3d.field.checkpoint import snapshot_steps  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
-from neural3d.method import RUNS_FOLDER  # noqa: E402
+from neural3d.method import RUNS_FOLDER, trained_scene_dirs  # noqa: E402
 from neural3d.training.run_folder import read_evals  # noqa: E402
 
 
@@ -163,6 +164,10 @@ def main(argv: list[str] | None = None) -> int:
     if not runs:
         print(f"no neural3d run folder under {args.results / RUNS_FOLDER}", file=sys.stderr)
         return 2
+    try:
+        refuse_report_only(trained_scene_dirs(runs), "measure time-to-target for a budget")
+    except ValueError as exc:
+        parser.error(str(exc))
     torch.set_num_threads(args.threads)
     extract = ExtractConfig(resolution=args.resolution)
     buildings = [run_checks(r, extract, args.last) for r in runs]

@@ -31,12 +31,13 @@ import torch  # noqa: E402
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from metrics.errors import absolute_percentage_error  # noqa: E402
 from neural3d.extract import semantic_mesh_of_field  # noqa: E402
 from neural3d.extraction.extract_config import ExtractConfig  # noqa: E402
 from neural3d.extraction.measure import measure_semantic_mesh  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
-from neural3d.method import RUNS_FOLDER, trained_runs  # noqa: E402
+from neural3d.method import RUNS_FOLDER, trained_runs, trained_scene_dirs  # noqa: E402
 
 SPLITS = ("labels", "probabilities")
 
@@ -102,6 +103,10 @@ def main(argv: list[str] | None = None) -> int:
     runs = trained_runs(args.results, args.scenes)
     if not runs:
         parser.error(f"no trained runs in {args.results / RUNS_FOLDER}")
+    try:
+        refuse_report_only(trained_scene_dirs(runs), "compare the window-area rules")
+    except ValueError as exc:
+        parser.error(str(exc))
     extract = ExtractConfig(resolution=args.resolution)
     rows = [compare_splits(run, extract) for run in runs]
     print(f"code {code_version()}, marching cubes {args.resolution}, "

@@ -43,12 +43,13 @@ import torch  # noqa: E402
 from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from metrics.errors import building_errors  # noqa: E402
 from neural3d.extract import measure_mesh, semantic_mesh_of_field  # noqa: E402
 from neural3d.extraction.extract_config import STAGES, ExtractConfig, without_stages  # noqa: E402
 from neural3d.extraction.meshing import SemanticMesh  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
-from neural3d.method import RUNS_FOLDER, trained_runs  # noqa: E402
+from neural3d.method import RUNS_FOLDER, trained_runs, trained_scene_dirs  # noqa: E402
 
 ALL = "all"
 MEASURED = ("wwr", "window_area_m2", "facade_area_m2", "facades", "footprint", "warnings")
@@ -221,6 +222,10 @@ def main(argv: list[str] | None = None) -> int:
     runs = trained_runs(args.results, args.scenes)
     if not runs:
         parser.error(f"no trained runs in {args.results / RUNS_FOLDER}")
+    try:
+        refuse_report_only(trained_scene_dirs(runs), "measure the stages")
+    except ValueError as exc:
+        parser.error(str(exc))
     saved = None
     if args.compare_to is not None:
         try:

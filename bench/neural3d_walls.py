@@ -35,6 +35,7 @@ from dataset.core.atomic import write_json_atomic  # noqa: E402
 from dataset.core.footprint import geojson_to_polygon, polygon_to_geojson  # noqa: E402
 from dataset.core.results import code_version  # noqa: E402
 from dataset.scenes.scene import read_scene  # noqa: E402
+from dataset.set_roles import refuse_report_only  # noqa: E402
 from metrics.errors import footprint_iou  # noqa: E402
 from neural3d.extract import field_sdf_fn  # noqa: E402
 from neural3d.extraction.extract_config import (  # noqa: E402
@@ -45,7 +46,7 @@ from neural3d.extraction.extract_config import (  # noqa: E402
 from neural3d.extraction.footprint import footprint_from_sdf  # noqa: E402
 from neural3d.extraction.straight_walls import straighten_footprint  # noqa: E402
 from neural3d.field.trained import load_trained_field  # noqa: E402
-from neural3d.method import RUNS_FOLDER, trained_runs  # noqa: E402
+from neural3d.method import RUNS_FOLDER, trained_runs, trained_scene_dirs  # noqa: E402
 
 CONTOUR = "contour"  # the column of the footprint as the contour gives it
 WORSE_BY = 0.001  # a pair "makes a building worse" when its IoU falls by more than this
@@ -131,6 +132,10 @@ def main(argv: list[str] | None = None) -> int:
     runs = trained_runs(args.results, args.scenes)
     if not runs:
         parser.error(f"no trained runs in {args.results / RUNS_FOLDER}")
+    try:
+        refuse_report_only(trained_scene_dirs(runs), "choose the straight-walls settings")
+    except ValueError as exc:
+        parser.error(str(exc))
     if min(args.tolerances + args.min_walls) <= 0:
         parser.error("--tolerances and --min-walls must be > 0")
     torch.set_num_threads(args.threads)

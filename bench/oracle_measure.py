@@ -62,6 +62,7 @@ from dataset.core.classes import CLASS_NAMES, NUM_CLASSES
 from dataset.core.mesh import LabelledMesh, triangle_areas_m2
 from dataset.core.results import code_version
 from dataset.presets import PRESETS, build_building, preset_recipes
+from dataset.set_roles import PRESET_ROLES
 from neural3d.config import TrainConfig
 from neural3d.extract import semantic_mesh_of_field
 from neural3d.extraction.extract_config import STAGES, ExtractConfig
@@ -236,6 +237,9 @@ def main(argv: list[str] | None = None) -> int:
         extract = ExtractConfig(resolution=args.resolution)
     except ValueError as exc:
         parser.error(str(exc))
+    if PRESET_ROLES.get(args.preset) == "report":
+        parser.error(f"{args.preset} is a report-only preset; the oracle chooses stages: use a "
+                     "tuning preset (paper, tiny) or the approval preset")
     recipes = [r for r in preset_recipes(args.preset)
                if args.buildings is None or r.id in args.buildings]
     unknown = sorted(set(args.buildings or ()) - {r.id for r in recipes})

@@ -16,6 +16,11 @@ a model; :func:`build_building` turns it into mesh + truth deterministically
 - ``segtrain``: 24 skyscrapers and 24 L-shaped buildings that are never evaluated, the
   training set of the mask segmenter (``segment/``); no realistic building (its four
   designs, only jittered, are the evaluated ones).
+- ``approval``: the place to ask "does this change do harm?" without touching ``heldout``:
+  six skyscrapers and six L-shaped buildings, and the eight held-out designs, at seeds no
+  other preset uses.
+
+What each preset may be used for (tuning, approval, report only): :mod:`dataset.set_roles`.
 
 Run ``python -m dataset.presets`` to print the ranges a preset spans.
 """
@@ -41,7 +46,7 @@ from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_param
 
 Family = Literal["skyscraper", "l_shaped", "realistic", "citygml"]
 FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "citygml")
-PRESETS = ("paper", "tiny", "heldout", "lod3", "segtrain")
+PRESETS = ("paper", "tiny", "heldout", "lod3", "segtrain", "approval")
 _SAFE_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 
 # Seeds of the tiny preset, picked because their samples are small (9 and 4 storeys, small
@@ -67,6 +72,10 @@ _LOD3_SEED = 4000  # + the building's index: cameras and looks of the lod3 scene
 # that is measured.
 _SEGTRAIN_FIRST_SEED = {"skyscraper": 1_000_000, "l_shaped": 2_000_000}
 _SEGTRAIN_PER_FAMILY = 24
+# Seeds of the approval preset: the first six from 8000 (9000), the held-out designs from 9500;
+# outside every other preset's seeds.
+_APPROVAL_SEEDS = {"skyscraper": tuple(range(8000, 8006)), "l_shaped": tuple(range(9000, 9006))}
+_APPROVAL_DESIGN_SEED = 9500
 
 
 @dataclass(frozen=True)
@@ -125,14 +134,16 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
             for k, m in enumerate(REALISTIC_MODELS)
         ]
         return tuple(recipes)
-    if name == "heldout":
+    if name in ("heldout", "approval"):
+        seeds, design_seed = ((_HELDOUT_SEEDS, _HELDOUT_DESIGN_SEED) if name == "heldout"
+                              else (_APPROVAL_SEEDS, _APPROVAL_DESIGN_SEED))
         recipes = [
-            BuildingRecipe(f"heldout_{family}_{i:02d}", family, seed)
+            BuildingRecipe(f"{name}_{family}_{i:02d}", family, seed)
             for family in ("skyscraper", "l_shaped")
-            for i, seed in enumerate(_HELDOUT_SEEDS[family])
+            for i, seed in enumerate(seeds[family])
         ]
         recipes += [
-            BuildingRecipe(f"heldout_{m}", "realistic", _HELDOUT_DESIGN_SEED + k, m)
+            BuildingRecipe(f"{name}_{m}", "realistic", design_seed + k, m)
             for k, m in enumerate(HELDOUT_MODELS)
         ]
         return tuple(recipes)

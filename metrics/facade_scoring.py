@@ -37,8 +37,8 @@ class ScoredResult:
 
     ``result``: the method's result with building figures less what lies out of scope
     (``wwr`` ``None`` where nothing is left). ``match``: the pairing (``None`` where the
-    result's facades cannot be paired: none reported, or own ids without locations). ``note``: what a reader
-    of the row must know (empty where nothing was left out).
+    result's facades cannot be paired: none reported, or own ids without locations).
+    ``note``: what a reader of the row must know (empty where nothing was left out).
     """
 
     result: MethodResult

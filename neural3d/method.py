@@ -10,6 +10,7 @@ It declares its command-line options (:data:`OPTIONS`: ``--neural3d-steps``,
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -102,6 +103,18 @@ def trained_runs(results_dir: Path, scenes: list[str] | None = None) -> list[Pat
         return []
     return sorted(p for p in runs_dir.iterdir() if (p / "checkpoint.pt").is_file()
                   and (scenes is None or p.name in scenes))
+
+
+def trained_scene_dirs(runs: list[Path]) -> list[Path]:
+    """The scene folder each run folder of :func:`trained_runs` was trained on (its
+    ``run.json``); runs without a readable record are skipped."""
+    out = []
+    for run in runs:
+        try:
+            out.append(Path(json.loads((Path(run) / "run.json").read_text())["scene_dir"]))
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+    return out
 
 
 def check_budget(budget: Neural3dBudget, runs_here: bool) -> None:
