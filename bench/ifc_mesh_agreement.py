@@ -59,7 +59,10 @@ def _row(name: str, path: str, truth) -> dict:
 
 def markdown_row(row: dict, ifc: dict) -> str:
     def rel(key: str) -> str:
-        return "" if row is ifc else f"{100 * (row[key] / ifc[key] - 1):+.2f} %"
+        if row is ifc:
+            return ""
+        percent = 100 * (row[key] / ifc[key] - 1)
+        return "0.00 %" if abs(percent) < 0.005 else f"{percent:+.2f} %"
 
     return (f"| {row['file']} | {row['path']} | {row['window_m2']:.2f} | "
             f"{row['facade_m2']:.2f} | {row['wwr']:.4f} | {row['closed']} / {row['bodies']} | "

@@ -3,8 +3,10 @@
 A BIM export is many bodies, one or more per element: closed solids, solids with a hole
 or a crack (IfcOpenShell cannot close every element), solids whose faces are wound
 inconsistently or inside out, and single-face panels (curtain-wall glass). A *body* is a
-set of faces joined by edges that exactly two of its faces share (after merging coincident
-vertices, within one element when elements are given), so touching bodies stay apart.
+set of faces joined across their edges (after merging coincident vertices, within one
+element when elements are given): an edge that two faces use joins them, and round an edge
+that more use (solids meeting there) each solid's two faces are paired
+(:mod:`dataset.importers.edge_pairs`), so touching bodies stay apart and each stays closed.
 :func:`orient_bodies` makes each body's winding consistent (trimesh's ``fix_winding``) and
 turns it so that its signed volume is positive: outward normals for every closed body,
 whatever the others do -- unless it is a cavity: a body whose faces point into a space

@@ -76,11 +76,14 @@ def _radial_pairs(v: np.ndarray, lo: np.ndarray, hi: np.ndarray, apex: np.ndarra
     d = _unit(v[hi] - v[lo])
     w = v[apex] - v[lo]
     w -= np.einsum("ij,ij->i", w, d)[:, None] * d  # the face's direction off the edge
-    e1 = _unit(w[starts][group])  # angle 0: the edge's first face
+    # Angle 0: the face that reaches furthest off the edge (a sliver gives no direction).
+    reach = np.linalg.norm(w, axis=1)
+    widest = np.lexsort((-reach, group))[starts]
+    e1 = _unit(w[widest][group])
     e2 = np.cross(d, e1)  # (e1, e2, d) right-handed: angle increases round d
     angle = np.mod(np.arctan2(np.einsum("ij,ij->i", w, e2), np.einsum("ij,ij->i", w, e1)),
                    2 * np.pi)
-    angle[angle > 2 * np.pi - TIE_RAD] -= 2 * np.pi  # just below the first face: with it
+    angle[angle > 2 * np.pi - TIE_RAD] -= 2 * np.pi  # just below angle 0: with it
     by_angle = np.lexsort((angle, group))
     gap = np.diff(angle[by_angle]) > TIE_RAD
     new_cluster = np.r_[True, gap | (group[by_angle][1:] != group[by_angle][:-1])]
