@@ -3,8 +3,10 @@
 A BIM export is many bodies, one or more per element: closed solids, solids with a hole
 or a crack (IfcOpenShell cannot close every element), solids whose faces are wound
 inconsistently or inside out, and single-face panels (curtain-wall glass). A *body* is a
-set of faces joined by edges that exactly two of its faces share (after merging coincident
-vertices, within one element when elements are given), so touching bodies stay apart.
+set of faces joined across their edges (after merging coincident vertices, within one
+element when elements are given): an edge that two faces use joins them, and round an edge
+that more use (solids meeting there) each solid's two faces are paired
+(:mod:`dataset.importers.edge_pairs`), so touching bodies stay apart and each stays closed.
 :func:`orient_bodies` makes each body's winding consistent (trimesh's ``fix_winding``) and
 turns it so that its signed volume is positive: outward normals for every closed body,
 whatever the others do -- unless it is a cavity: a body whose faces point into a space
@@ -20,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dataset.core.mesh import MERGE_DECIMALS
+from dataset.importers.edge_pairs import face_pairs
 from dataset.rendering.raycast import INSIDE_WINDING, winding_numbers
 
 SHEET_RELATIVE_THICKNESS = 1e-6
@@ -80,8 +83,7 @@ def orient_bodies(vertices_m: np.ndarray, faces: np.ndarray,
     g = np.zeros(len(f), dtype=np.int64) if group is None else np.asarray(group, np.int64)
     merged = _merge_within_groups(v, f, g)
     n_faces = len(f)
-    adjacency = trimesh.Trimesh(np.zeros((merged.max(initial=-1) + 1, 3)), merged,
-                                process=False, validate=False).face_adjacency
+    adjacency = face_pairs(_merged_positions(v, f, merged), merged)
     components = trimesh.graph.connected_components(adjacency, nodes=np.arange(n_faces),
                                                     min_len=1)
     body = np.empty(n_faces, dtype=np.int64)
@@ -144,6 +146,13 @@ def _merge_within_groups(v: np.ndarray, f: np.ndarray, g: np.ndarray) -> np.ndar
                            corner_group[:, None].astype(np.float64)], axis=1)
     _, inverse = np.unique(keys, axis=0, return_inverse=True)
     return inverse.reshape(-1, 3)
+
+
+def _merged_positions(v: np.ndarray, f: np.ndarray, merged: np.ndarray) -> np.ndarray:
+    """(U, 3) a position for every merged vertex (one of the corners merged into it)."""
+    out = np.zeros((merged.max(initial=-1) + 1, 3))
+    out[merged.reshape(-1)] = v[f.reshape(-1)]
+    return out
 
 
 def _edge_defects(faces: np.ndarray, body: np.ndarray, n_bodies: int
