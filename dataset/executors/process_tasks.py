@@ -160,19 +160,20 @@ def _receive(process: Any, conn: Connection, show: Callable[[Progress], None], *
         while conn.poll():
             kind, payload = conn.recv()
             if kind == _VALUE:
-                value = payload
-                break
+                _close(process, conn)
+                return payload
             show(payload)
-        else:
-            if not exited:
-                return _RUNNING
-            raise EOFError
-    except (EOFError, OSError):
-        process.join()
-        value = TaskLost(f"its process exited with code {process.exitcode} before it finished")
+    except (EOFError, OSError):  # its end of the pipe closed without a value: it is gone
+        exited = True
+    if not exited:
+        return _RUNNING
+    _close(process, conn)
+    return TaskLost(f"its process exited with code {process.exitcode} before it finished")
+
+
+def _close(process: Any, conn: Connection) -> None:
     process.join()
     conn.close()
-    return value
 
 
 def _task_main(fn: Callable[..., Any], args: tuple[Any, ...], conn: Connection) -> None:
