@@ -22,7 +22,7 @@ Three measurements, printed as Markdown (and written to ``--out``):
    next to the tasks (true for 2D methods on small scenes only).
 
 The tiny preset is rendered into a temporary folder at the built-in default's
-size (``metrics.benchmark_cache.DefaultBenchmark``), unless ``--data`` is given.
+size (``dataset.benchmark_cache.DefaultBenchmark``), unless ``--data`` is given.
 """
 
 from __future__ import annotations
@@ -40,11 +40,11 @@ from pathlib import Path
 
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
+from dataset.benchmark_cache import DefaultBenchmark  # noqa: E402
 from dataset.core.atomic import write_text_atomic  # noqa: E402
 from dataset.core.results import MethodResult  # noqa: E402
 from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
 from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
-from metrics.benchmark_cache import DefaultBenchmark  # noqa: E402
 from metrics.compare import compare  # noqa: E402
 from metrics.executors import make_executor  # noqa: E402
 from metrics.methods import method_specs  # noqa: E402

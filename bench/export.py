@@ -20,7 +20,7 @@ from pathlib import Path
 
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
-from metrics.benchmark_cache import DefaultBenchmark  # noqa: E402
+from dataset.benchmark_cache import DefaultBenchmark  # noqa: E402
 from metrics.export import FORMATS, export, read_inputs  # noqa: E402
 
 

@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 from datetime import datetime, timezone
 from pathlib import Path
 
+from dataset.benchmark_cache import DefaultBenchmark
 from dataset.core.atomic import write_json_atomic
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.results import code_version
@@ -24,7 +25,6 @@ from figures.pipeline import plot_2dss_pipeline
 from figures.renders import plot_example_renders
 from figures.style import MissingInput
 from metrics.aggregate import aggregate_by_family
-from metrics.benchmark_cache import DefaultBenchmark
 from metrics.compare import FOOTPRINTS_FOLDER, PIPELINE_FOLDER, PROVENANCE_FILE
 from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report import PER_BUILDING_NAME, read_building_errors_csv

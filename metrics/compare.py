@@ -27,6 +27,7 @@ from datetime import datetime, timezone
 from functools import partial
 from pathlib import Path
 
+from dataset.benchmark_cache import ensure_benchmark
 from dataset.core.atomic import write_json_atomic, write_text_atomic
 from dataset.core.cli_errors import check_output_folder, exit_cli, run_cli
 from dataset.core.method import available_methods
@@ -34,7 +35,6 @@ from dataset.core.results import code_version
 from dataset.core.truth import BuildingTruth, read_building
 from dataset.executors.ray_tasks import RayConfig
 from metrics.aggregate import GroupSummary, aggregate_by_family
-from metrics.benchmark_cache import ensure_benchmark
 from metrics.compare_args import CompareRequest, compare_request, parse_compare_args
 from metrics.compare_outputs import (
     keep_pipeline_images,

@@ -13,12 +13,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from dataset.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark, default_results_folder
 from dataset.core.cli_errors import add_debug_flag
 from dataset.core.method import Method
 from dataset.core.protocols import VIEW_PROTOCOLS
 from dataset.degrade.spec import DEGRADATIONS, DegradeSpec, parse_specs
 from dataset.executors.ray_tasks import add_executor_arguments
-from metrics.benchmark_cache import DEFAULT_CACHE, DefaultBenchmark
 from metrics.method_args import add_method_options, method_configs
 from metrics.methods import METHODS
 from metrics.predicted_masks import MasksRequest, parse_masks
@@ -163,7 +163,7 @@ def compare_request(args: argparse.Namespace, methods: Mapping[str, Method]) -> 
     configs = method_configs(args, methods, names, runs_here=runs_here,
                              short_run=default is not None or args.robustness)
     return CompareRequest(
-        data=data, results=args.results or data.with_name(f"{data.name}-results"),
+        data=data, results=args.results or default_results_folder(data),
         out=args.out or data.with_name(f"{data.name}-compare"), methods=names,
         views=_listed(args.views), configs=configs, default=default,
         degradation=parse_specs(args.degrade, seed=args.degrade_seed) if args.degrade else (),

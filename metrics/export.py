@@ -19,6 +19,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
 from dataset.core.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.footprint import geojson_to_polygon
@@ -26,7 +27,6 @@ from dataset.core.orientation import true_north_xy_from_world
 from dataset.core.results import MethodResult, code_version, read_result
 from dataset.core.truth import BuildingTruth, read_building
 from metrics.aggregate import method_rank, protocol_rank
-from metrics.benchmark_cache import DefaultBenchmark
 from metrics.export_cityjson import cityjson_building
 from metrics.export_formats import (
     cea_csv,
@@ -230,7 +230,7 @@ def _paths(args: argparse.Namespace) -> tuple[Path, Path | None, Path]:
     data = args.data
     if results is None:
         folder = DefaultBenchmark().folder
-        results, data = folder.with_name(f"{folder.name}-results"), data or folder
+        results, data = default_results_folder(folder), data or folder
     if data is None and results.name.endswith("-results"):
         guess = results.with_name(results.name.removesuffix("-results"))
         data = guess if guess.is_dir() else None

@@ -19,12 +19,12 @@ from dataclasses import replace
 from pathlib import Path
 
 import torch
-from tqdm import tqdm
 
 from dataset.core.atomic import write_json_atomic
 from dataset.core.classes import CLASS_NAMES
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from dataset.core.device import resolve_device
+from dataset.core.progress import progress_bar
 from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from dataset.core.resources import check_training_resources
 from dataset.core.scene_record import scene_name
@@ -142,8 +142,9 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         })
         write_log(run_dir, log_rows)
 
-    bar = tqdm(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
-               dynamic_ncols=True, disable=None)
+    # A tqdm bar, or in a task process of the comparison, one that reports to its parent.
+    bar = progress_bar(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
+                       dynamic_ncols=True, disable=None)
     previous_sigterm = _sigterm_as_interrupt()
     try:
         while step < config.iterations:

@@ -1,28 +1,36 @@
-"""Write files and folders so that a crash or Ctrl-C never leaves them half-written."""
+"""Write files and folders so that a crash or Ctrl-C never leaves them half-written.
+
+The temporary file or folder is made with ``os.open`` / ``os.mkdir`` asking for mode
+0666 / 0777, so the user's umask decides the final mode as for any file they write (0644 and
+0755 under umask 022); ``tempfile.mkstemp`` would keep its private 0600 (0700) through the
+rename, leaving every result unreadable to everyone else.
+"""
 
 from __future__ import annotations
 
 import json
 import os
 import shutil
-import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+
+_TRIES = 100  # names to try before giving up (each one a fresh random name)
 
 
 def write_bytes_atomic(path: str | Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    tmp, fd = _make_sibling(path, ".tmp", lambda p: os.open(
+        p, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666))
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
         os.replace(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
 
 
@@ -45,7 +53,7 @@ def atomic_directory(final: str | Path) -> Iterator[Path]:
     """
     final = Path(final)
     final.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(dir=final.parent, prefix=f".{final.name}.", suffix=".partial"))
+    tmp, _ = _make_sibling(final, ".partial", lambda p: os.mkdir(p, 0o777))
     try:
         yield tmp
         if final.exists():
@@ -54,3 +62,22 @@ def atomic_directory(final: str | Path) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+def _make_sibling(final: Path, suffix: str, make: Callable[[Path], Any]) -> tuple[Path, Any]:
+    """A new hidden ``.<name>.<random><suffix>`` beside ``final``, made by ``make(path)``
+    (which raises ``FileExistsError`` if the path is taken); the path and what ``make``
+    returned.
+
+    Raises
+    ------
+    FileExistsError
+        If every name tried was taken.
+    """
+    for _ in range(_TRIES):
+        candidate = final.with_name(f".{final.name}.{os.urandom(6).hex()}{suffix}")
+        try:
+            return candidate, make(candidate)
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary name beside {final} after {_TRIES} tries")

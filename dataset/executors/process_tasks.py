@@ -11,7 +11,10 @@ capacity runs alone. Several tasks may share a GPU (each reserving a fraction of
 Each task gets a fresh *spawned* process (not forked: Embree, BLAS and CUDA do not survive a
 fork), so a task that crashes its process (a segfault, the OOM killer) costs only itself: it
 comes back as :class:`~dataset.executors.ray_tasks.TaskLost`, as does a task that raises.
-Tasks ignore Ctrl-C and their progress bars are off (the caller reports progress); leaving
+Tasks ignore Ctrl-C and draw no progress bars: a bar made with
+:func:`dataset.core.progress.progress_bar` (a training's) sends its progress through the task's
+pipe, ahead of the value, and this process shows it (``progress``: by default a
+:class:`~dataset.executors.task_progress.TaskProgressLines`, a line per running task); leaving
 the iteration early (Ctrl-C, an error in the caller) sends every running task SIGTERM, which
 it turns into ``SystemExit`` so that its ``finally`` blocks (and
 :func:`dataset.core.atomic.atomic_directory`) clean up what it was writing, and waits for it.
@@ -25,13 +28,20 @@ import signal
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from functools import partial
 from multiprocessing.connection import Connection, wait
 from typing import Any
 
+from dataset.core.progress import Progress, send_progress_to
 from dataset.executors.ray_tasks import TaskLost, TaskResources
+from dataset.executors.task_progress import TaskProgressLines
 
 WAIT_S = 0.5  # longest a wait for a finished task blocks, so that Ctrl-C is seen promptly
 _SLACK = 1e-9  # fractions of a GPU that add up to one
+_PROGRESS, _VALUE = "progress", "value"  # what a task's message carries
+_RUNNING = object()  # a task that has sent progress only, so far
+ShowProgress = Callable[[int, Progress | None], None]
+"""(task index, its progress; ``None`` once it is over)."""
 
 
 @dataclass(frozen=True)
@@ -66,15 +76,18 @@ def run_in_processes(
     fn: Callable[..., Any],
     calls: Sequence[tuple[tuple[Any, ...], TaskResources]],
     capacity: Capacity,
+    progress: ShowProgress | None = None,
 ) -> Iterator[tuple[int, Any]]:
     """Run ``fn(*args)`` for every ``(args, resources)`` in ``calls``, each in its own spawned
-    process, at most ``capacity`` reserved at once.
+    process, at most ``capacity`` reserved at once; what the tasks' progress bars report goes
+    to ``progress`` (default: a :class:`TaskProgressLines`).
 
     Yields ``(index into calls, value)`` in the order the tasks finish; the value is a
     :class:`~dataset.executors.ray_tasks.TaskLost` for a task that raised, whose process died,
     or whose function or arguments cannot be sent to a process (they must pickle).
     """
     context = multiprocessing.get_context("spawn")
+    show = TaskProgressLines() if progress is None else progress
     waiting = list(range(len(calls)))
     running: dict[int, tuple[Any, Connection]] = {}
     try:
@@ -90,11 +103,16 @@ def run_in_processes(
                              timeout=WAIT_S))
             for i, (process, conn) in list(running.items()):
                 if conn in ready or process.sentinel in ready:
-                    del running[i]
-                    yield i, _collect(process, conn)
+                    value = _receive(process, conn, partial(show, i),
+                                     exited=process.sentinel in ready)
+                    if value is not _RUNNING:
+                        del running[i]
+                        show(i, None)
+                        yield i, value
     finally:  # Ctrl-C or an early exit: nothing keeps running for nobody
-        for process, _ in running.values():
+        for i, (process, _) in running.items():
             process.terminate()
+            show(i, None)
         for process, conn in running.values():
             process.join()
             conn.close()
@@ -134,22 +152,36 @@ def _start(context: Any, fn: Callable[..., Any], args: tuple[Any, ...]
     return process, receive
 
 
-def _collect(process: Any, conn: Connection) -> Any:
-    """The value a finished task sent, or :class:`TaskLost` if its process sent none."""
+def _receive(process: Any, conn: Connection, show: Callable[[Progress], None], *,
+             exited: bool) -> Any:
+    """Read what a task sent: its progress reports go to ``show``; then its value, a
+    :class:`TaskLost` if its process ended without one, or ``_RUNNING`` if it goes on."""
     try:
-        value = conn.recv()
-    except (EOFError, OSError):
-        process.join()
-        value = TaskLost(f"its process exited with code {process.exitcode} before it finished")
+        while conn.poll():
+            kind, payload = conn.recv()
+            if kind == _VALUE:
+                _close(process, conn)
+                return payload
+            show(payload)
+    except (EOFError, OSError):  # its end of the pipe closed without a value: it is gone
+        exited = True
+    if not exited:
+        return _RUNNING
+    _close(process, conn)
+    return TaskLost(f"its process exited with code {process.exitcode} before it finished")
+
+
+def _close(process: Any, conn: Connection) -> None:
     process.join()
     conn.close()
-    return value
 
 
 def _task_main(fn: Callable[..., Any], args: tuple[Any, ...], conn: Connection) -> None:
-    """In the task's process: run it and send back its value (or why it has none)."""
+    """In the task's process: run it, sending its progress, then its value (or why it has
+    none)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _exit_on_sigterm)
+    send_progress_to(lambda progress: conn.send((_PROGRESS, progress)))
     try:
         value = fn(*args)
     except (KeyboardInterrupt, SystemExit):
@@ -157,9 +189,10 @@ def _task_main(fn: Callable[..., Any], args: tuple[Any, ...], conn: Connection) 
     except Exception as exc:
         value = TaskLost(f"{type(exc).__name__}: {exc}".strip())
     try:
-        conn.send(value)
+        conn.send((_VALUE, value))
     except Exception as exc:  # a value that does not pickle
-        conn.send(TaskLost(f"its value cannot be sent back: {type(exc).__name__}: {exc}"))
+        conn.send((_VALUE, TaskLost(
+            f"its value cannot be sent back: {type(exc).__name__}: {exc}")))
     conn.close()
 
 

@@ -1,11 +1,20 @@
-"""baselines.cli and both CLIs on the tiny benchmark (fixture from conftest)."""
+"""baselines.cli and both CLIs: on the tiny benchmark (fixture from conftest), on the built-in
+default benchmark without --data, writing where metrics.compare reads, printing what they
+measured."""
+
+import shutil
+from functools import partial
 
 import pytest
 
+import baselines.cli
 from baselines import wwr2ds, wwr2dss
-from baselines.cli import default_results_folder, scene_folders
-from dataset.core.results import read_result
+from baselines.cli import scene_folders
+from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
+from dataset.core.method import available_methods
+from dataset.core.results import MethodResult, read_result
 from dataset.core.truth import read_building
+from metrics.compare_args import compare_request, parse_compare_args
 
 
 def test_scene_folders_and_default_results_folder(tmp_path):
@@ -16,8 +25,8 @@ def test_scene_folders_and_default_results_folder(tmp_path):
     bench = tmp_path / "bench"
     assert [p.name for p in scene_folders(bench)] == ["a", "b"]
     assert scene_folders(bench / "a") == [bench / "a"]
-    assert default_results_folder(bench) == tmp_path / "results"
-    assert default_results_folder(bench / "a") == tmp_path / "results"
+    assert default_results_folder(bench) == tmp_path / "bench-results"
+    assert default_results_folder(bench / "a") == bench / "a-results"
     with pytest.raises(ValueError, match="neither a scene folder"):
         scene_folders(bench / "notes")
     with pytest.raises(ValueError, match="does not exist"):
@@ -42,3 +51,44 @@ def test_both_clis_on_the_tiny_benchmark(tiny_benchmark, tmp_path, views):
             # 96 px images: a loose sanity bound, not an accuracy test.
             assert abs(r.wwr - truth.wwr) < 0.1
     assert any((tmp_path / "dbg").glob(f"*__{views}__f1__v0__rectified.png"))
+
+
+def assert_table_shows(out: str, result: MethodResult) -> None:
+    """The printed table holds the building's WWR and each facade's row as in the file."""
+    head = f"{result.scene}  {result.method} {result.protocol}: building WWR {result.wwr:.3f}"
+    assert head in out
+    rows = {tuple(line.split()[:2]) for line in out.splitlines() if line.startswith("  ")}
+    for f in result.facades:
+        assert (str(f.id), "-" if f.wwr is None else f"{f.wwr:.3f}") in rows
+
+
+def test_results_go_where_compare_reads_them_and_are_printed(clean_scene, tmp_path, capsys):
+    data = tmp_path / "bench"
+    shutil.copytree(clean_scene, data / clean_scene.name)
+    assert wwr2ds.main(["--views", "ideal", "--data", str(data)]) == 0
+    methods = available_methods()
+    request = compare_request(parse_compare_args(["--data", str(data), "--no-run"], methods),
+                              methods)
+    path = request.results / f"{clean_scene.name}__2D-S__ideal.json"
+    out = capsys.readouterr().out
+    assert_table_shows(out, read_result(path))
+    assert f"-> {path}" in out
+
+
+@pytest.mark.slow
+def test_without_data_the_default_benchmark_is_made_and_measured(tmp_path, monkeypatch, capsys):
+    # The default benchmark, small: 64 px and 8 orbit views instead of 128 px and 40.
+    default = partial(DefaultBenchmark, root=tmp_path / "cache", resolution=64, views=8,
+                      workers=1)
+    monkeypatch.setattr(baselines.cli, "DefaultBenchmark", default)
+    assert wwr2dss.main(["--views", "multi"]) == 0
+    out, err = capsys.readouterr()
+    folder = default().folder
+    assert f"no --data: the built-in 'tiny' benchmark in {folder} (generating it now)" in err
+    scenes = scene_folders(folder)
+    assert len(scenes) == 3
+    for scene in scenes:
+        result = read_result(default_results_folder(folder) / f"{scene.name}__2D-SS__multi.json")
+        assert_table_shows(out, result)
+    assert wwr2ds.main(["--views", "multi"]) == 0
+    assert f"benchmark in {folder} (cached)" in capsys.readouterr().err

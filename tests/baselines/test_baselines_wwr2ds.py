@@ -84,7 +84,7 @@ def test_run_averages_views_then_facades_and_reports_missing(tmp_path):
 def test_cli_writes_one_result_per_scene(tmp_path, capsys):
     scene = _scene(tmp_path)
     assert main(["--views", "ideal", "--data", str(scene.root.parent)]) == 0
-    out = tmp_path / "results" / "facade_scene__2D-S__ideal.json"  # <benchmark>/../results
+    out = tmp_path / "bench-results" / "facade_scene__2D-S__ideal.json"  # <data>-results
     assert read_result(out).method == "2D-S"
     assert json.loads(out.read_text())["facades"][2]["missing"] is True
     assert "warning:" in capsys.readouterr().err

@@ -170,11 +170,12 @@ def test_cli_writes_results_and_debug_images(tmp_path, capsys):
     argv = ["--views", "ideal", "--data", str(scene.root), "--weighting", "area",
             "--debug-images", str(dbg)]
     assert main(argv) == 0
-    result = read_result(tmp_path / "results" / "two__2D-SS__ideal.json")
+    written = tmp_path / "bench" / "two-results" / "two__2D-SS__ideal.json"  # <data>-results
+    result = read_result(written)
     assert result.method == "2D-SS" and result.config["weighting"] == "area"
     for kind in ("mask", "corners", "rectified"):
         assert (dbg / f"two__ideal__f2__v0__{kind}.png").is_file()
-    assert str(tmp_path / "results" / "two__2D-SS__ideal.json") in capsys.readouterr().out
+    assert f"-> {written}" in capsys.readouterr().out
 
 
 def test_cli_fails_cleanly_when_nothing_is_left(tmp_path, capsys):

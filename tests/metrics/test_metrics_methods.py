@@ -4,7 +4,7 @@ from dataclasses import asdict
 
 import pytest
 
-from metrics.benchmark_cache import DefaultBenchmark
+from dataset.benchmark_cache import DefaultBenchmark
 from metrics.methods import method_specs
 from metrics.robustness import RobustnessStudy
 from neural3d.method import Neural3dBudget

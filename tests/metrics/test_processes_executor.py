@@ -5,9 +5,11 @@ files only; neural3d reserves its threads on CPU and a share of the GPU on CUDA.
 """
 
 import os
+import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import asdict, replace
 from functools import partial
@@ -15,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from dataset.core.progress import progress_bar
 from dataset.core.results import read_result
 from dataset.executors.ray_tasks import TaskResources
 from metrics.executors import make_executor
@@ -37,6 +40,15 @@ def _dies_on_first_scene(scene_dir, protocol):
 def _2ds_noting_its_process(folder, scene_dir, protocol):
     """2D-S, writing the id of the process it ran in into ``folder``."""
     Path(folder, f"{scene_dir.name}.pid").write_text(str(os.getpid()))
+    return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
+
+
+def _2ds_after_a_counted_loop(scene_dir, protocol):
+    """2D-S after a loop of three steps with a progress bar, as a training has."""
+    bar = progress_bar(total=3, desc=f"fake training {scene_dir.name}")
+    for _ in range(3):
+        bar.update()
+    bar.close()
     return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
 
 
@@ -91,6 +103,20 @@ def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
     assert not (tmp_path / "results" / "tiny_l_shaped__2D-S__ideal.json").exists()
 
 
+@pytest.mark.slow
+def test_a_heavy_run_s_progress_is_shown_by_the_parent(tiny_benchmark, tmp_path, capsys):
+    scenes = find_scenes(tiny_benchmark)[:2]
+    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
+                   run=_2ds_after_a_counted_loop)
+    outcomes = run_missing(scenes, [spec], tmp_path / "results", log=_quiet,
+                           execute=make_executor("processes", cpus=2))
+    assert [o.status for o in outcomes] == ["ran"] * 2
+    err = capsys.readouterr().err  # not a terminal: a plain line when a run first reports
+    for scene in scenes:
+        assert re.search(rf"(^|\r)fake training {scene.name}: 1/3 steps, [0-9.]+ steps/s, "
+                         r"[0-9:]+ left$", err, re.MULTILINE), err
+
+
 def test_neural3d_reserves_its_threads_or_a_share_of_the_gpu_and_records_neither_share():
     assert reserve(Neural3dBudget(threads=1)) == (1.0, 0.0)
     assert reserve(Neural3dBudget(threads=3)) == (3.0, 0.0)
@@ -120,6 +146,9 @@ def test_neural3d_trained_two_at_a_time_gives_the_local_results(tiny_benchmark, 
                    str(out / "compare"), "--executor", executor, "--cpus", "2"]
         done = subprocess.run(command, capture_output=True, text=True, timeout=600)
         assert done.returncode == 0, done.stderr[-3000:]
+        if executor == "processes":  # each training's progress reached the parent's log
+            for scene in find_scenes(tiny_benchmark):
+                assert re.search(rf"neural3d {scene.name}: \d+/20 steps", done.stderr)
         results[executor] = {p.name: replace(read_result(p), wall_time_s=0.0)
                              for p in sorted((out / "results").glob("*.json"))}
         runs = sorted(p.name for p in (out / "results" / "neural3d_runs").iterdir())
@@ -140,25 +169,34 @@ def test_ctrl_c_stops_the_trainings_with_checkpoints_and_whole_results(
                "--neural3d-steps", "100000", "--neural3d-threads", "1", "--results",
                str(results), "--out", str(tmp_path / "out"), "--executor", "processes",
                "--cpus", "2"]
-    proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     runs = results / "neural3d_runs"
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(iter(proc.stderr.readline, "")),
+                              daemon=True)
+    reader.start()
     try:
+        # Both training loops run once both have reported progress (a fixed wait after their
+        # config.json was not enough on a busy machine: a training still loading its scene
+        # has no checkpoint to save).
         deadline = time.monotonic() + 300
-        while not (runs.is_dir() and len([p for p in runs.iterdir()
-                                          if (p / "config.json").exists()]) == 2):
+        while len(set(re.findall(r"neural3d (\S+): \d+/100000 steps", "".join(lines)))) < 2:
             if proc.poll() is not None or time.monotonic() > deadline:
                 proc.kill()
-                pytest.fail(f"two trainings did not start: {proc.communicate()[1][-3000:]}")
+                reader.join(timeout=10)
+                pytest.fail(f"two trainings did not start: {''.join(lines)[-3000:]}")
             time.sleep(0.1)
-        time.sleep(3.0)
         tic = time.monotonic()
         proc.send_signal(signal.SIGINT)
-        _, stderr = proc.communicate(timeout=120)
+        proc.wait(timeout=120)
+        reader.join(timeout=10)
+        stderr = "".join(lines)
     finally:  # never leave a 100000-step training behind
         if proc.poll() is None:
             proc.kill()
-            proc.communicate()
+            proc.wait()
     assert proc.returncode == 130, stderr
     assert time.monotonic() - tic < 60 and "interrupted" in stderr
     written = sorted(p for p in results.iterdir() if p.is_file())

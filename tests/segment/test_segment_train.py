@@ -3,12 +3,16 @@ blind to the truth, and nothing left behind by bad input."""
 
 import json
 import shutil
+import time
 from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
+from typing import NamedTuple
 
 import numpy as np
 import pytest
 
+import segment.train
 from dataset.core.classes import CLASS_NAMES
 from dataset.presets import preset_recipes
 from dataset.scenes.images import read_labels, read_rgb, write_labels, write_rgb
@@ -32,24 +36,46 @@ FEW_STEPS = TrainConfig(steps=3, batch=2, threads=1, val_every=0, validate_every
                         augment=AugmentConfig(crop_px=32))
 
 
+FAST_CPU_S = 0.012
+"""The CPU time of the three steps on a fast machine (the clock is faked): the record used to
+round it to 0.0 s."""
+
+
+class Trained(NamedTuple):
+    path: Path  # the weights
+    wall_s: float  # the wall time the test measured around the training
+
+
 @pytest.fixture(scope="module")
-def trained(clean_scene, tmp_path_factory) -> Path:
-    """Weights trained for a few steps on the box scene (an imported building: no preset)."""
+def trained(clean_scene, tmp_path_factory) -> Trained:
+    """Weights trained for a few steps on the box scene (an imported building: no preset), on a
+    process clock that says the training took ``FAST_CPU_S`` of CPU."""
     out = tmp_path_factory.mktemp("weights") / "box.pt"
-    train_segmenter([clean_scene], out, FEW_STEPS, progress=False)
-    return out
+    cpu_clock = iter([50.0])
+    fast = SimpleNamespace(perf_counter=time.perf_counter,
+                           process_time=lambda: next(cpu_clock, 50.0 + FAST_CPU_S))
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(segment.train, "time", fast)
+        tic = time.perf_counter()
+        train_segmenter([clean_scene], out, FEW_STEPS, progress=False)
+        wall_s = time.perf_counter() - tic
+    return Trained(out, wall_s)
 
 
 @pytest.mark.slow
 def test_a_few_steps_write_weights_with_their_record(trained, clean_scene):
-    record = json.loads(trained.with_suffix(".json").read_text())
+    record = json.loads(trained.path.with_suffix(".json").read_text())
     assert record["steps_run"] == 3 and not record["cut_short"]
     assert [s["scene"] for s in record["trained_on"]] == [clean_scene.name]
     assert record["trained_on"][0]["preset"] is None and record["validated_on"] == []
     assert record["config"]["network"] == {"base_channels": 4, "levels": 3, "num_classes": 6}
     assert len(record["class_weights"]) == len(CLASS_NAMES)
     assert record["provenance"]["config"]["seed"] == 0
-    assert record["wall_time_s"] > 0 and record["cpu_time_s"] > 0
+    # The times keep milliseconds: a fast machine's 12 ms of CPU are 0.012 s, not 0.0. The wall
+    # time lies within what the test measured around the call (to its rounding, 0.5 ms); reading
+    # a scene and three steps take far more than 0.5 ms on any machine.
+    assert record["cpu_time_s"] == FAST_CPU_S
+    assert 0 < record["wall_time_s"] <= trained.wall_s + 5e-4
 
 
 def test_training_refuses_evaluated_buildings(tiny_benchmark):
@@ -88,11 +114,11 @@ def test_the_split_keeps_a_building_on_one_side(clean_scene):
 
 
 def test_mask_copies_are_cached_by_provenance(trained, clean_scene, tmp_path):
-    segmenter = network_segmenter(trained, threads=1)
+    segmenter = network_segmenter(trained.path, threads=1)
     copy = predicted_scene(clean_scene, tmp_path, segmenter, progress=False)
     scene = read_scene(copy)
     record = json.loads((copy / "transforms.json").read_text())[RECORD_KEY]
-    assert record["config"]["segmenter"] == str(trained)
+    assert record["config"]["segmenter"] == str(trained.path)
     assert set(record["config"]) >= {"weights", "code", "torch"}
     assert set(record["code"]) == {"segment.scene_masks"}
     first = scene.frames[0]
@@ -113,7 +139,7 @@ def test_mask_copies_are_cached_by_provenance(trained, clean_scene, tmp_path):
 
 def test_the_segmenter_never_sees_the_truth(trained, clean_scene, tmp_path):
     """Scrambled exact masks, instances and a changed building.json give the same masks."""
-    segmenter = network_segmenter(trained, threads=1)
+    segmenter = network_segmenter(trained.path, threads=1)
     changed = shutil.copytree(clean_scene, tmp_path / "source" / clean_scene.name)
     rng = np.random.default_rng(0)
     for fr in read_scene(changed).frames:

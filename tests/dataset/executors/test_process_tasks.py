@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from dataset.core.progress import Progress, progress_bar
 from dataset.executors.process_tasks import Capacity, machine_capacity, run_in_processes
 from dataset.executors.ray_tasks import TaskLost, TaskResources
 
@@ -104,6 +105,32 @@ def test_leaving_early_stops_running_tasks_through_their_finally_blocks(tmp_path
 
 def _dispatch(fn, *args):
     return fn(*args)
+
+
+def _counts(steps: int, step_s: float) -> int:
+    """A loop of ``steps`` steps with a progress bar, as a training has."""
+    bar = progress_bar(total=steps, desc="count", initial=1)
+    for _ in range(1, steps):
+        time.sleep(step_s)
+        bar.update()
+    bar.set_postfix(loss="0.5000")
+    bar.close()
+    return steps
+
+
+def test_a_task_s_progress_reaches_the_caller_before_its_value():
+    seen = []
+
+    def show(task, progress):
+        seen.append((task, progress))
+
+    got = dict(run_in_processes(_counts, [((4, 0.0), TaskResources())], Capacity(cpus=1),
+                                progress=show))
+    assert got == {0: 4}
+    # The first update is sent at once, the next ones at most every 0.5 s, the last on close.
+    assert seen[0] == (0, Progress("count", 2, 4, 1, seen[0][1].elapsed_s))
+    assert seen[-2] == (0, Progress("count", 4, 4, 1, seen[-2][1].elapsed_s, "loss=0.5000"))
+    assert seen[-1] == (0, None)  # over
 
 
 def test_capacity_is_checked_and_the_machine_has_cores():

@@ -1,4 +1,10 @@
-"""The built-in default benchmark of ``python -m metrics.compare``, made once into a cache."""
+"""The built-in default benchmark, made once into a cache, and where a benchmark's results go.
+
+``python -m metrics.compare`` and the 2D baselines' commands (``python -m baselines.wwr2dss``)
+run on the default when given no ``--data``, and all of them keep the results of a benchmark
+``<data>`` in ``<data>-results`` (:func:`default_results_folder`), so that what one writes the
+other reads.
+"""
 
 from __future__ import annotations
 
@@ -44,6 +50,13 @@ class DefaultBenchmark:
             + f"{repeated}. This takes up to about {self.expected_minutes * comparisons:g} "
             f"minutes on 2 CPU cores."
         )
+
+
+def default_results_folder(data: str | Path) -> Path:
+    """``<data>-results`` beside ``data`` (a folder of scene folders, or one scene folder),
+    ``data`` made absolute: the result files of the methods run on it."""
+    data = Path(data).resolve()
+    return data.with_name(f"{data.name}-results")
 
 
 def ensure_benchmark(benchmark: DefaultBenchmark) -> Path:
