@@ -43,7 +43,9 @@ from dataset.core.mesh import LabelledMesh
 from dataset.core.truth import Building
 from dataset.rendering.raycast import Raycaster
 
-_UP = np.array([0.0, 0.0, 1.0])
+STREET_FRAMES_PER_BUILDING = 100
+"""Street frames assumed per building before it is planned (disk and memory estimates); the
+lod3 preset's buildings get 30-100 with the defaults (docs/rendering.md)."""
 
 
 @dataclass(frozen=True)
@@ -147,10 +149,9 @@ def street_views(building: Building, config: StreetConfig, *, context: bool
     stations = street_stations(building, config)
     if not len(stations.positions_m):
         return []
-    everything, _ = _caster(building, with_neighbours=True)
-    clear = ~everything.occluded(stations.positions_m,
-                                 np.broadcast_to(_UP, stations.positions_m.shape))
-    seen_by, n_own = _caster(building, with_neighbours=context)
+    everything, _ = scene_caster(building, with_neighbours=True)
+    clear = everything.open_to_sky(stations.positions_m)
+    seen_by, n_own = scene_caster(building, with_neighbours=context)
     k = config.intrinsics(config.check_resolution)
     poses = []
     for eye, fwd in zip(stations.positions_m[clear], stations.forward[clear]):
@@ -191,7 +192,7 @@ def _along(path: np.ndarray, spacing_m: float) -> tuple[np.ndarray, np.ndarray]:
     return starts[k] + (s - cum[k])[:, None] * direction, direction
 
 
-def _caster(building: Building, *, with_neighbours: bool) -> tuple[Raycaster, int]:
+def scene_caster(building: Building, *, with_neighbours: bool) -> tuple[Raycaster, int]:
     """A caster of the building (and its neighbours), and how many of its faces (the first
     ones) are the building's."""
     meshes = [building.mesh, *(n.mesh for n in building.context if with_neighbours)]
