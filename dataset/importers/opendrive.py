@@ -36,8 +36,9 @@ from lxml import etree
 from scipy.special import fresnel
 
 SAMPLE_STEP_M = 0.5
-"""Largest arc length between two samples of a line: a 0.5 m chord on the tightest curve
-of the Ingolstadt file (radius ~6 m) misses the curve by 5 mm."""
+"""Largest arc length between two samples of a line: on the tightest bend of the Ingolstadt
+file's reference lines (radius 2.0 m, road 1446000) a 0.5 m chord misses the curve by 16 mm,
+and most of its bends are far wider; street cameras stand metres apart."""
 _OPENERS = {".gz": gzip.open, ".xz": lzma.open}
 
 

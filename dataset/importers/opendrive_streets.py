@@ -9,7 +9,8 @@ transformed from the header's ``geoReference`` to the city model's CRS (pyproj; 
 Ingolstadt file's PROJ string is EPSG:32632, the buildings' CRS, so the transform is the
 identity), then shifted by the building's ``offset_m``. Heights take the same shift: the
 Ingolstadt roads' elevations and the buildings' ground surfaces are in one height system
-(roads within about a metre of the ground surfaces beside them).
+(the lane point nearest each of the 49 scene buildings lies -0.25 to +2.1 m, median
++0.08 m, above the building's lowest ground point, which is z = 0).
 """
 
 from __future__ import annotations
