@@ -179,3 +179,12 @@ def test_committed_roads_run_between_the_buildings():
                 if lanes.distance(footprint) > 30.0:
                     far.append(b.gml_id)
     assert count == len(scene) and not crossed and not far
+
+
+def test_bad_settings_are_refused():
+    with pytest.raises(ValueError, match="camera_height_m"):
+        StreetConfig(camera_height_m=12.0)
+    with pytest.raises(ValueError, match="headings_deg"):
+        StreetConfig(headings_deg=())
+    with pytest.raises(ValueError, match="N >= 2"):
+        Street("one point", np.zeros((1, 3)))
