@@ -11,9 +11,9 @@ car driving round the block.
 **Where it takes frames.** A station every :attr:`StreetConfig.spacing_m` metres of each path
 (:func:`street_stations`; stations closer than half that to an earlier one are dropped, so
 overlapping lanes and junction connectors give one row of stations, as a street-view
-service's panoramas), kept when within :attr:`StreetConfig.capture_radius_m` of the
-building's rough location (the centre of its x/y bounding box: what an address or a map
-footprint gives) and not under anything (a vertical ray from the camera hits neither the
+service's panoramas), kept when within :attr:`StreetConfig.capture_range_m` of the
+building's rough outline (its x/y bounding box: what a map footprint gives) and not under
+anything (a vertical ray from the camera hits neither the
 building nor a neighbour: passages, arcades, a path through a house). At each station one
 frame per heading of :attr:`StreetConfig.headings_deg` (from the driving direction, left
 positive), pitched up by :attr:`StreetConfig.pitch_deg`, with a
@@ -59,7 +59,8 @@ class StreetConfig:
     square-on and the four obliques at 45 degrees (a rig's side and oblique cameras, or the
     crops of a panorama). ``pitch_deg``: up from horizontal, so that a 90-degree lens 6-8 m
     from a 15 m facade sees from its base to its eaves. ``fov_deg``: horizontal (= vertical)
-    field of view. ``capture_radius_m``: stations this close to the building's location.
+    field of view. ``capture_range_m``: stations this close to the building's x/y bounding
+    box (so a large building's far streets count too).
     ``min_building_fraction``: share of a ``check_resolution``-pixel render the building
     must cover. ``fallback_offset_m``: without streets, the path's distance from the block
     (half a street: pavement and a lane); ``block_gap_m``: outlines this close are one block.
@@ -70,7 +71,7 @@ class StreetConfig:
     headings_deg: tuple[float, ...] = (90.0, -90.0, 45.0, -45.0, 135.0, -135.0)
     pitch_deg: float = 20.0
     fov_deg: float = 90.0
-    capture_radius_m: float = 50.0
+    capture_range_m: float = 40.0
     min_building_fraction: float = 0.05
     check_resolution: int = 64
     fallback_offset_m: float = 6.0
@@ -79,8 +80,8 @@ class StreetConfig:
     def __post_init__(self) -> None:
         if not 1.0 <= self.camera_height_m <= 5.0:
             raise ValueError(f"camera_height_m must be in [1, 5] m, got {self.camera_height_m}")
-        if self.spacing_m <= 0 or self.capture_radius_m <= 0 or self.fallback_offset_m <= 0:
-            raise ValueError("spacing_m, capture_radius_m and fallback_offset_m must be > 0")
+        if self.spacing_m <= 0 or self.capture_range_m <= 0 or self.fallback_offset_m <= 0:
+            raise ValueError("spacing_m, capture_range_m and fallback_offset_m must be > 0")
         if not self.headings_deg:
             raise ValueError("headings_deg needs at least one heading")
         if not -60.0 <= self.pitch_deg <= 60.0:
@@ -121,16 +122,16 @@ def street_paths(building: Building, config: StreetConfig) -> list[np.ndarray]:
 
 
 def street_stations(building: Building, config: StreetConfig) -> Stations:
-    """The stations within the capture radius (module docstring), before the check that
+    """The stations within the capture range (module docstring), before the check that
     nothing stands over them."""
-    centre = 0.5 * (building.mesh.vertices_m[:, :2].min(axis=0)
-                    + building.mesh.vertices_m[:, :2].max(axis=0))
+    lo = building.mesh.vertices_m[:, :2].min(axis=0)
+    hi = building.mesh.vertices_m[:, :2].max(axis=0)
     kept_xy: list[np.ndarray] = []
     kept_fwd: list[np.ndarray] = []
     for path in street_paths(building, config):
         xy, fwd = _along(path, config.spacing_m)
         for p, f in zip(xy, fwd):
-            if np.hypot(*(p - centre)) > config.capture_radius_m:
+            if np.hypot(*np.maximum(np.maximum(lo - p, p - hi), 0.0)) > config.capture_range_m:
                 continue
             if kept_xy and np.min(np.hypot(*(np.array(kept_xy) - p).T)) < 0.5 * config.spacing_m:
                 continue

@@ -41,7 +41,7 @@ def test_straight_street_stations_and_frames():
     building = replace(make_box_building(), streets=(_street_along_x(-15.0),))
     config = StreetConfig()
     stations = street_stations(building, config)
-    # every 5 m from x = -50; within 50 m of the centre: |x| <= sqrt(50^2 - 15^2) = 47.7
+    # every 5 m from x = -50; within 40 m of the box: |x| - 10 <= sqrt(40^2 - 9^2) = 38.97
     np.testing.assert_allclose(stations.positions_m[:, 0], np.arange(-45.0, 46.0, 5.0))
     np.testing.assert_allclose(stations.positions_m[:, 1:], [[-15.0, 2.5]] * 19)
     np.testing.assert_allclose(stations.forward, [[1.0, 0.0]] * 19)
@@ -51,7 +51,7 @@ def test_straight_street_stations_and_frames():
     square_on = [p for p in poses if np.allclose(p[:3, 3], [0.0, -15.0, 2.5])
                  and np.allclose(-p[:3, 2], [0.0, np.cos(PITCH), np.sin(PITCH)])]
     assert len(square_on) == 1
-    far = StreetConfig(capture_radius_m=10.0)  # no station within 10 m of the centre
+    far = StreetConfig(capture_range_m=8.0)  # no station within 8 m of the box
     assert street_views(building, far, context=False) == []
 
 
@@ -78,7 +78,7 @@ def test_no_road_network_drives_round_the_block():
     # a neighbour 1 m away (a party-wall gap) joins the block; the path goes round both
     other = _shifted(building.mesh, 21.0)
     pair = replace(building, context=(Neighbour("east", other),))
-    ring = street_stations(pair, StreetConfig(capture_radius_m=100.0)).positions_m
+    ring = street_stations(pair, StreetConfig(capture_range_m=100.0)).positions_m
     block = shapely.union_all([BOX_XY, box(11.0, -6.0, 31.0, 6.0)]).buffer(0.5)
     np.testing.assert_allclose(shapely.distance(block, shapely.points(ring[:, :2])), 6.0 - 0.5,
                                atol=2e-3)
