@@ -52,9 +52,9 @@ lod3 preset's buildings get 30-100 with the defaults (docs/rendering.md)."""
 class StreetConfig:
     """How the street capture is taken (module docstring; docs/rendering.md "Street views").
 
-    ``camera_height_m``: above the ground plane (Street View's car camera stands about
-    2.5 m high). ``spacing_m``: between stations along a path (mobile-mapping cars trigger
-    a frame every few metres; 5 m is a street-view panorama's usual step). ``headings_deg``:
+    ``camera_height_m``: above the ground plane (a car's roof-mast camera, about 2.5 m).
+    ``spacing_m``: between stations along a path (mobile-mapping cars trigger a frame every
+    few metres; consecutive Street View panoramas lie 5-10 m apart). ``headings_deg``:
     the frames of one station, from the driving direction, left positive: both sides
     square-on and the four obliques at 45 degrees (a rig's side and oblique cameras, or the
     crops of a panorama). ``pitch_deg``: up from horizontal, so that a 90-degree lens 6-8 m
