@@ -28,6 +28,7 @@ from dataset.core.resources import FACADE_VIEWS_PER_BUILDING, check_generate_res
 from dataset.executors.ray_tasks import RayConfig, add_executor_arguments
 from dataset.executors.worker_pool import worker_pool
 from dataset.importers.source import BuildingEntry, Entry, NoOptions, SceneEntry, write_scenes
+from dataset.rendering.street_views import STREET_FRAMES_PER_BUILDING, StreetConfig
 from dataset.scenes.scene_writer import (
     GenerateConfig,
     PlannedView,
@@ -232,6 +233,11 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
                              "view (sources that know them: CityGML, the lod3 preset); they are "
                              "background in the labels and the truth is unchanged "
                              "(docs/importing.md section 8)")
+    render.add_argument("--street", action="store_true",
+                        help="add the street frames a mobile-mapping car takes from the road "
+                             "network (the lod3 preset's OpenDRIVE lanes; elsewhere a path "
+                             "round the block), split 'street', placed without the truth "
+                             "(docs/rendering.md, 'Street views')")
     render.add_argument("--seed", type=int, default=0,
                         help="seed for cameras and looks (default 0)")
     p.add_argument("--workers", type=int, default=1,
@@ -254,6 +260,7 @@ def main(argv: list[str] | None = None) -> int:
         config = GenerateConfig(
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
             fov_deg=args.fov, supersampling=args.supersampling, context=args.context,
+            street=StreetConfig() if args.street else None,
         )
         source, path = chosen_source(args, SOURCES)
         if args.executor == "ray" and source is not PRESET_SOURCE:
@@ -287,7 +294,8 @@ def _check_resources(args: argparse.Namespace, config: GenerateConfig, buildings
         raise ValueError(f"--workers must be >= 1, got {args.workers}")
     if buildings:
         check_generate_resources(
-            config.resolution, config.supersampling, config.views + FACADE_VIEWS_PER_BUILDING,
+            config.resolution, config.supersampling, config.views + FACADE_VIEWS_PER_BUILDING
+            + (STREET_FRAMES_PER_BUILDING if config.street is not None else 0),
             buildings, min(args.workers, buildings) if buildings > 1 else args.workers,
             args.out)
 

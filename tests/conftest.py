@@ -136,7 +136,9 @@ def assert_complete_scene(root: Path, config: GenerateConfig) -> None:
                     frame.normal_file_path, frame.instance_file_path):
             assert rel is not None and scene.path(rel).is_file(), rel
         assert (frame.facade_id is not None) == (frame.split in ("ideal", "multi"))
-        assert frame.intrinsics == config.intrinsics()
+        street = frame.split == "street" and config.street is not None
+        assert frame.intrinsics == (config.street.intrinsics(config.resolution) if street
+                                    else config.intrinsics())
     n_train = len(scene.frames_in("train"))
     assert n_train + len(scene.frames_in("eval")) == config.views
     assert n_train == int(np.floor(config.views * config.train_fraction))

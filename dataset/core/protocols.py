@@ -18,10 +18,13 @@ Protocol = Literal["ideal", "multi", "train"]
 VIEW_PROTOCOLS: tuple[ViewProtocol, ...] = get_args(ViewProtocol)
 IDEAL_PROTOCOL, MULTI_PROTOCOL = VIEW_PROTOCOLS
 TRAIN_PROTOCOL: Protocol = "train"
-Split = Literal[Protocol, "eval"]
-"""A scene frame's split: a protocol's views, or ``eval``: held-out orbit views no method runs
-on (neural3d evaluates its renders on them)."""
+Split = Literal[Protocol, "eval", "street"]
+"""A scene frame's split: a protocol's views, ``eval``: held-out orbit views no method runs
+on (neural3d evaluates its renders on them), or ``street``: the frames a car takes from the
+road (``--street``, :mod:`dataset.rendering.street_views`; placed and named without the
+truth: no ``facade_id``; no method reads them yet)."""
 EVAL_SPLIT: Split = "eval"
+STREET_SPLIT: Split = "street"
 SPLITS: tuple[Split, ...] = get_args(Split)
 PROTOCOLS: tuple[Protocol, ...] = get_args(Protocol)
 """Every protocol, in the tables' order."""

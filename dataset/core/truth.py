@@ -16,7 +16,7 @@ from typing import Any, Literal
 from dataset.core.appearance import SurfaceAppearance
 from dataset.core.atomic import write_json_atomic
 from dataset.core.mesh import LabelledMesh
-from dataset.core.neighbours import Neighbour
+from dataset.core.neighbours import Neighbour, Street
 from dataset.core.orientation import (
     NORTH_SOURCES,
     NorthSource,
@@ -198,20 +198,22 @@ class Building:
     """A building as the generator (or the importer) makes it: labelled mesh + exact truth.
 
     Where the source knows them: ``appearance``, the mesh faces' textures and colours
-    (:mod:`dataset.core.appearance`), and ``context``, the buildings around it
-    (:mod:`dataset.core.neighbours`); neither changes the truth.
+    (:mod:`dataset.core.appearance`), ``context``, the buildings around it, and ``streets``,
+    the lanes of its road network (:mod:`dataset.core.neighbours`); none changes the truth.
     """
 
     mesh: LabelledMesh
     truth: BuildingTruth
     appearance: SurfaceAppearance | None = None
     context: tuple[Neighbour, ...] = ()
+    streets: tuple[Street, ...] = ()
 
     def __post_init__(self) -> None:
         if self.appearance is not None and len(self.appearance.face_material) != len(
                 self.mesh.faces):
             raise ValueError("a building's appearance needs one entry per face of its mesh")
         object.__setattr__(self, "context", tuple(self.context))
+        object.__setattr__(self, "streets", tuple(self.streets))
 
 
 def write_building(path: str | Path, truth: BuildingTruth) -> None:

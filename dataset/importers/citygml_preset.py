@@ -6,7 +6,10 @@ xz-compressed CityGML 2.0 file per folder, ``<id>/<id>.xml.xz``, with the textur
 in ``<id>/textures/`` (downscaled), and ``buildings.json``: the scene buildings (scene id,
 file, ``gml:id``, window count; every building with a covered facade, in scene order) and
 every file with its bounding box (the neighbours of ``--context`` and of the party-wall
-rule are the files near a building, :mod:`dataset.importers.citygml_context`).
+rule are the files near a building, :mod:`dataset.importers.citygml_context`). The city's road
+network, ``road_network/*.xodr.xz`` (OpenDRIVE, CC BY-NC-SA 4.0, its own ``LICENSE``), gives
+every building its streets (the lanes ``--street`` drives, :mod:`dataset.importers.
+opendrive_streets`).
 
     python -m dataset.importers.citygml_preset SRC [--out dataset/examples/lod3_ingolstadt]
 
@@ -23,7 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 import lzma
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from tqdm import tqdm
@@ -36,9 +39,13 @@ from dataset.importers.citygml_context import CityFile, file_bbox_m, files_near
 from dataset.importers.citygml_files import citygml_stem
 from dataset.importers.citygml_import import building_from_citygml, import_citygml_building
 from dataset.importers.citygml_read import read_citygml
+from dataset.importers.opendrive_streets import streets_in_frame
 
 LOD3_DIR = Path(__file__).resolve().parents[1] / "examples" / "lod3_ingolstadt"
 MANIFEST = "buildings.json"
+ROAD_NETWORK = LOD3_DIR / "road_network" / (
+    "2021-04-22_HD21_529_Intersections_CityHall_Ingolstadt.xodr.xz")
+"""The source's ``models/road-network/opendrive/`` file of that name, xz-compressed."""
 SOURCE_REPO = "https://github.com/savenow/lod3-road-space-models"
 SOURCE_COMMIT = "fdddf41d62c49282bf319b79b9f0a7b0ce1152b2"
 TEXTURE_MAX_PX = 256
@@ -77,7 +84,8 @@ def lod3_files(folder: Path = LOD3_DIR) -> tuple[CityFile, ...]:
 
 
 def build_lod3_building(entry_id: str, file: str, folder: Path = LOD3_DIR) -> Building:
-    """Import one shipped building with its neighbours (the same truth on every run).
+    """Import one shipped building with its neighbours and, where the folder has the road
+    network, its streets (the same truth on every run).
 
     Raises
     ------
@@ -86,8 +94,13 @@ def build_lod3_building(entry_id: str, file: str, folder: Path = LOD3_DIR) -> Bu
     """
     files = lod3_files(folder)
     (own,) = [f for f in files if f.path == Path(folder) / file]
-    return import_citygml_building(own.path, entry_id,
-                                   neighbour_files=files_near(own.bbox_m, files))
+    building = import_citygml_building(own.path, entry_id,
+                                       neighbour_files=files_near(own.bbox_m, files))
+    roads = Path(folder) / ROAD_NETWORK.relative_to(LOD3_DIR)
+    if not roads.is_file():
+        return building
+    return replace(building, streets=streets_in_frame(
+        roads, building.truth.extra["crs"], building.truth.extra["offset_m"]))
 
 
 def make_lod3(src: Path, out: Path) -> list[dict]:

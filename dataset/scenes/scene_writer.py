@@ -1,7 +1,8 @@
 """One building -> one complete scene folder (DESIGN.md layout), written atomically.
 
 The folder holds orbit views (Algorithm 1) split into train/eval, one ideal view
-per facade and five multi views per facade, each with RGB, z-depth, semantics,
+per facade and five multi views per facade (and, with ``--street``, the street frames a car
+takes from the road), each with RGB, z-depth, semantics,
 normals and facade ids (``instances/``: ground truth for tests and evaluation
 only), plus ``transforms.json``, ``building.json`` and ``mesh.ply``. It is
 written into a hidden temporary folder and renamed into place when complete
@@ -23,7 +24,14 @@ from tqdm import tqdm
 from dataset.core.atomic import atomic_directory
 from dataset.core.camera import Intrinsics
 from dataset.core.mesh import write_labelled_ply
-from dataset.core.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL, Split
+from dataset.core.protocols import (
+    EVAL_SPLIT,
+    IDEAL_PROTOCOL,
+    MULTI_PROTOCOL,
+    STREET_SPLIT,
+    TRAIN_PROTOCOL,
+    Split,
+)
 from dataset.core.provenance import (
     Provenance,
     ProvenanceChange,
@@ -39,6 +47,7 @@ from dataset.rendering.facade_views import FacadeViewConfig, ideal_views, multi_
 from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views
 from dataset.rendering.render import Raycaster, render_view
 from dataset.rendering.shading import RgbConfig
+from dataset.rendering.street_views import StreetConfig, street_views
 from dataset.scenes.images import (
     DEPTH_MAX_UNITS,
     write_depth_m,
@@ -68,7 +77,9 @@ class GenerateConfig:
     ``ideal``/``multi``: whether to add those facade views. ``context``: render the
     buildings the source places around the building (``Building.context``) as occluders in
     every view, each camera moved in front of the neighbours in its way
-    (:mod:`dataset.rendering.context`); the truth is the same either way.
+    (:mod:`dataset.rendering.context`); the truth is the same either way. ``street``: add
+    the street frames (:mod:`dataset.rendering.street_views`, their own lens); ``None`` (the
+    default) leaves it out of the recorded config, so scenes without it are as before.
     """
 
     resolution: int = 512
@@ -80,6 +91,7 @@ class GenerateConfig:
     ideal: bool = True
     multi: bool = True
     context: bool = False
+    street: StreetConfig | None = None
     orbit: OrbitConfig = field(default_factory=OrbitConfig)
     facade_views: FacadeViewConfig = field(default_factory=FacadeViewConfig)
     rgb: RgbConfig = field(default_factory=RgbConfig)
@@ -105,18 +117,21 @@ class GenerateConfig:
 
 @dataclass(frozen=True)
 class PlannedView:
-    """A view to render: its split, file stem, pose (4, 4) and facade (ideal/multi only)."""
+    """A view to render: its split, file stem, pose (4, 4), facade (ideal/multi only) and
+    intrinsics where they are not the config's (street frames)."""
 
     split: Split
     name: str
     world_from_camera: np.ndarray
     facade_id: int | None = None
+    intrinsics: Intrinsics | None = None
 
 
 def plan_views(
     building: Building, raycaster: Raycaster, config: GenerateConfig, *, seed: int
 ) -> list[PlannedView]:
-    """All views of a scene: orbit (train/eval interleaved), then ideal, then multi."""
+    """All views of a scene: orbit (train/eval interleaved), then ideal, then multi, then
+    street (with ``config.street``)."""
     k = config.intrinsics()
     orbit = sample_orbit_views(building, raycaster, k, config.views, config=config.orbit, seed=seed)
     f = config.train_fraction
@@ -133,6 +148,11 @@ def plan_views(
         for i, (fid, pose) in enumerate(multi_views(building, raycaster, k,
                                                     config=config.facade_views, seed=seed + 1)):
             views.append(PlannedView(MULTI_PROTOCOL, f"{MULTI_PROTOCOL}_{i:04d}", pose, fid))
+    if config.street is not None:
+        street_k = config.street.intrinsics(config.resolution)
+        for i, pose in enumerate(street_views(building, config.street, context=config.context)):
+            views.append(PlannedView(STREET_SPLIT, f"{STREET_SPLIT}_{i:04d}", pose,
+                                     intrinsics=street_k))
     return views
 
 
@@ -180,7 +200,9 @@ def generate_scene(
         raise ValueError(f"workers must be >= 1, got {workers}")
     meshes = ViewMeshes(building, context=config.context)
     k = config.intrinsics()
-    views = [replace(v, world_from_camera=meshes.street_pose(v.world_from_camera))
+    # street frames already stand in the street: only the planned views move
+    views = [v if v.split == STREET_SPLIT else
+             replace(v, world_from_camera=meshes.street_pose(v.world_from_camera))
              for v in plan_views(building, meshes.alone, config, seed=seed)]
     unit = depth_unit_for(config.depth_unit_scale_factor, meshes.rendered,
                           [v.world_from_camera for v in views])
@@ -264,6 +286,7 @@ def _render_view(
     tmp: Path, meshes: ViewMeshes, k: Intrinsics, view: PlannedView, config: GenerateConfig,
     seed: int, unit: float,
 ) -> Frame:
+    k = k if view.intrinsics is None else view.intrinsics
     gt, rgb = render_view(meshes.rendered, k, view.world_from_camera, config=config.rgb,
                           seed=seed, supersampling=config.supersampling,
                           textures=meshes.textures)
@@ -313,4 +336,7 @@ def _check_scene_name(name: str) -> None:
 
 
 def _config_json(config: GenerateConfig) -> dict[str, Any]:
-    return json.loads(json.dumps(asdict(config)))
+    record = json.loads(json.dumps(asdict(config)))
+    if config.street is None:  # scenes without street frames record what they always did
+        del record["street"]
+    return record
