@@ -16,6 +16,7 @@ import numpy as np
 from dataset.core.camera import Intrinsics, pixel_centres, unproject_depth_to_world
 from dataset.core.classes import SemanticClass
 from dataset.core.method_input import MethodInput, require_method_input
+from dataset.core.protocols import OWN_FACADE_PROTOCOLS
 from dataset.core.scene_record import Frame, scene_name
 from dataset.scenes.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
 
@@ -68,9 +69,12 @@ class PosedViews:
         self.warnings.append(f"{view_name} skipped: {reason}")
 
 
-def has_facade_ids(scene: MethodInput, split: str) -> bool:
-    """Whether any frame of ``split`` names the facade it was taken of."""
-    return any(f.facade_id is not None for f in scene.frames_in(split))
+def finds_own_facades(scene: MethodInput, split: str) -> bool:
+    """Whether the 2D methods find the facades themselves on ``split``: a protocol declared
+    so (:data:`dataset.core.protocols.OWN_FACADE_PROTOCOLS`) or a split none of whose frames
+    names the facade it was taken of."""
+    return split in OWN_FACADE_PROTOCOLS or all(f.facade_id is None
+                                                for f in scene.frames_in(split))
 
 
 def load_posed_views(scene: MethodInput, split: str) -> PosedViews:

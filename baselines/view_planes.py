@@ -8,8 +8,10 @@ plane is a line in the ground plane x-y: sequential one-point RANSAC draws a pix
 vertical plane through it with its normal, counts the pixels within ``threshold_m`` of it
 whose normal agrees within ``normal_agreement_deg``, keeps the best, refits it by least
 squares to its inliers (twice), removes them and starts again. The inliers of one plane are
-cut where they leave a gap wider than ``gap_m`` along it: each run of them is one
-:class:`ViewPlane` (two coplanar walls apart are two facades).
+cut where they leave a gap wider than ``gap_m`` along it: each run of them with at least
+``min_points`` pixels spanning at least ``min_width_m`` is one :class:`ViewPlane` (two
+coplanar walls apart are two facades; a run narrower than that is the crease of a corner,
+whose pixels' normals blend both walls').
 """
 
 from __future__ import annotations
@@ -31,14 +33,15 @@ class PlaneFitConfig:
     normal_agreement_deg: float = 20.0
     max_tilt_deg: float = 15.0
     gap_m: float = 1.0
+    min_width_m: float = 0.5
     min_points: int = 50
     hypotheses: int = 64
     max_planes: int = 8
     max_points: int = 20000
 
     def __post_init__(self) -> None:
-        if not (self.threshold_m > 0 and self.gap_m > 0):
-            raise ValueError("threshold_m and gap_m must be > 0")
+        if not (self.threshold_m > 0 and self.gap_m > 0 and self.min_width_m >= 0):
+            raise ValueError("threshold_m and gap_m must be > 0 and min_width_m >= 0")
         if not (0 < self.normal_agreement_deg < 90 and 0 < self.max_tilt_deg < 90):
             raise ValueError("normal_agreement_deg and max_tilt_deg must be in (0, 90)")
         if min(self.min_points, self.hypotheses, self.max_planes, self.max_points) < 1:
@@ -154,7 +157,7 @@ def _runs_along(view_index: int, normal: np.ndarray, offset_m: float, points_m: 
     cuts = np.flatnonzero(np.diff(s[order]) > config.gap_m) + 1
     out = []
     for run in np.split(order, cuts):
-        if len(run) < config.min_points:
+        if len(run) < config.min_points or np.ptp(s[run]) < config.min_width_m:
             continue
         pts = points_m[run]
         sample = pts if len(pts) <= 500 else pts[rng.choice(len(pts), 500, replace=False)]

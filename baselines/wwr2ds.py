@@ -27,7 +27,7 @@ from baselines.cli import add_common_arguments, main_guarded, run_scenes
 from baselines.debug import colour_labels, write_debug_image
 from baselines.facade_mask import facade_class_mask, isolate_facade_2ds
 from baselines.own_facades import OwnFacadesConfig, run_2ds_own
-from baselines.posed_views import has_facade_ids
+from baselines.posed_views import finds_own_facades
 from baselines.views import FacadeView, Protocol, ViewError, load_views
 from dataset.core.classes import SemanticClass
 from dataset.core.cli_errors import check_output_folder
@@ -121,7 +121,7 @@ def run_2ds(scene: MethodInput, protocol: Protocol, config: Wwr2dsConfig = Wwr2d
     ValueError
         If the protocol is unknown, the scene has no such views, or no view is usable.
     """
-    if not has_facade_ids(scene, protocol):
+    if finds_own_facades(scene, protocol):
         return run_2ds_own(scene, protocol, config.own_facades, combine=config.combine,
                            method=METHOD, method_config=asdict(config))
     start = time.perf_counter()

@@ -54,7 +54,7 @@ from baselines.facade_mask import (
     tolerance_for_depth_steps,
 )
 from baselines.own_facades import OwnFacadesConfig, run_2dss_own
-from baselines.posed_views import has_facade_ids
+from baselines.posed_views import finds_own_facades
 from baselines.rectify import (
     OUTSIDE,
     quadrilateral_area_px,
@@ -249,7 +249,7 @@ def run_2dss(scene: MethodInput, protocol: Protocol, config: Wwr2dssConfig = Wwr
     ValueError
         If the protocol is unknown, the scene has no such views, or no view is usable.
     """
-    if not has_facade_ids(scene, protocol):
+    if finds_own_facades(scene, protocol):
         return run_2dss_own(scene, protocol, config.own_facades, seed=config.seed,
                             method=METHOD, method_config=asdict(config))
     start = time.perf_counter()

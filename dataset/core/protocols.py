@@ -2,8 +2,9 @@
 
 ``ideal``: one fronto-parallel view per facade; ``multi``: five oblique views
 per facade (both carry the truth's facade ids, so a result's facades are the
-truth's); ``train``: the orbit training views (neural3d numbers its own
-facades). The names are also the scene's frame splits (:data:`Split`).
+truth's); ``train``: the orbit training views, which carry no facade id (neural3d,
+and the 2D methods, number their own facades on them: :data:`OWN_FACADE_PROTOCOLS`). The
+names are also the scene's frame splits (:data:`Split`).
 """
 
 from __future__ import annotations
@@ -18,6 +19,9 @@ Protocol = Literal["ideal", "multi", "train"]
 VIEW_PROTOCOLS: tuple[ViewProtocol, ...] = get_args(ViewProtocol)
 IDEAL_PROTOCOL, MULTI_PROTOCOL = VIEW_PROTOCOLS
 TRAIN_PROTOCOL: Protocol = "train"
+OWN_FACADE_PROTOCOLS: tuple[Protocol, ...] = (TRAIN_PROTOCOL,)
+"""Protocols of posed views without facade ids, on which the 2D methods find the facades
+themselves (:mod:`baselines.own_facades`); another such split (a street capture) joins here."""
 Split = Literal[Protocol, "eval"]
 """A scene frame's split: a protocol's views, or ``eval``: held-out orbit views no method runs
 on (neural3d evaluates its renders on them)."""
