@@ -4,7 +4,7 @@ Two view planes (:class:`baselines.view_planes.ViewPlane`) are the same facade w
 normals agree within ``angle_deg``, each one's inliers lie within ``offset_m`` of the other
 plane on average, and their extents along the plane overlap or leave a gap of at most
 ``gap_m``. The relation is closed transitively (union-find): each group is one facade, a
-:class:`FacadePlane` refitted to all its members' inliers.
+:class:`FacadePlane` whose normal and offset are its members' averaged.
 """
 
 from __future__ import annotations
@@ -94,21 +94,18 @@ def merge_view_planes(planes: list[ViewPlane], config: MergeConfig) -> list[Faca
 
 
 def facade_plane(members: list[ViewPlane]) -> FacadePlane:
-    """The vertical plane through all members' inliers (total least squares in x-y), outward
-    as their normals, with the union of their extents."""
-    pts = np.concatenate([m.points_m for m in members])
-    mean_normal = sum(m.n_points * m.normal for m in members)
-    centre = pts[:, :2].mean(axis=0)
-    _, _, vt = np.linalg.svd(pts[:, :2] - centre, full_matrices=False)
-    normal = np.array([vt[1, 0], vt[1, 1], 0.0])
-    if normal @ mean_normal < 0:
-        normal = -normal
+    """The plane of a group: its members' normals and offsets averaged, each weighted by its
+    inlier count, with the union of their extents."""
+    weights = np.array([m.n_points for m in members], dtype=np.float64)
+    normal = weights @ np.array([m.normal for m in members])
+    normal[2] = 0.0
+    normal /= np.linalg.norm(normal)
+    offset = float(weights @ [np.mean(m.points_m @ normal) for m in members] / weights.sum())
     along = np.cross(UP, normal)
     s = np.array([_s_range_on(m, along) for m in members])
     z = np.array([m.z_range_m for m in members])
-    return FacadePlane(normal, float(normal[:2] @ centre), (float(s[:, 0].min()),
-                       float(s[:, 1].max())), (float(z[:, 0].min()), float(z[:, 1].max())),
-                       tuple(members))
+    return FacadePlane(normal, offset, (float(s[:, 0].min()), float(s[:, 1].max())),
+                       (float(z[:, 0].min()), float(z[:, 1].max())), tuple(members))
 
 
 def _s_range_on(plane: ViewPlane, along: np.ndarray) -> tuple[float, float]:
