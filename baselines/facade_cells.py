@@ -1,16 +1,23 @@
 """A facade's window, wall and door areas by voting on a grid of cells on its plane (2D-SS).
 
-The facade's plane (:class:`baselines.plane_merge.FacadePlane`) is cut into square cells of
+Each wall, window or door pixel of a view belongs to at most one facade: the one whose
+plane its surface lies on (at most ``front_m`` in front of it, at most ``back_m`` behind it:
+a window's glass is set back from the wall; within the facade's extent widened by
+``pad_m``), the nearest where several planes qualify (the facets of a curved wall, a
+corner), so no surface is counted by two facades (:func:`pixel_owners`).
+
+Each facade's plane (:class:`baselines.plane_merge.FacadePlane`) is cut into square cells of
 ``cell_m`` over its extent widened by ``pad_m`` on every side. Each view in front of the
 plane (seeing it at an angle of incidence whose cosine is at least ``min_view_cos``) looks
 up the pixel each cell centre projects to, and votes:
 
-- the pixel's class (wall, window or door; anything else votes "none") where the pixel's
-  surface lies on the plane: at most ``front_m`` in front of it, at most ``back_m`` behind
-  it (a window's glass is set back from the wall);
-- "none" where the pixel has no depth or its surface lies farther behind (the cell is off
-  the facade: the view looks past it);
-- nothing where the surface lies farther in front (something hides the cell).
+- the pixel's class where the pixel belongs to this facade; "none" where its surface lies
+  on the plane but it belongs to no facade (roof, balcony, anything but wall, window or
+  door);
+- "none" where the pixel has no depth or its surface lies farther behind the plane, or
+  behind it on another facade (the cell is off the facade: the view looks past it);
+- nothing where the surface lies farther in front, or in front on another facade
+  (something hides the cell).
 
 A cell's class is the majority of its votes (a tie goes to "none"); cells without a vote
 are not counted. Each area is its cells times ``cell_m``², so a part of the facade seen by
@@ -81,41 +88,80 @@ def cell_centres_m(facade: FacadePlane, config: CellConfig) -> tuple[np.ndarray,
     return points, s, z
 
 
-def cell_votes(facade: FacadePlane, points_m: np.ndarray, views: list[PosedView],
-               config: CellConfig) -> tuple[np.ndarray, int]:
-    """(M, 4) vote counts (none, wall, window, door) of the cells at ``points_m`` (M, 3), and
-    how many views voted wall, window or door somewhere."""
-    votes = np.zeros((len(points_m), 4), dtype=np.int64)
-    voters = 0
+def pixel_owners(view: PosedView, facades: list[FacadePlane], config: CellConfig) -> np.ndarray:
+    """(H, W) int: for each wall, window or door pixel, the index in ``facades`` of the facade
+    its surface lies on (within ``front_m`` in front to ``back_m`` behind its plane and within
+    its extent widened by ``pad_m``), the nearest plane where several qualify; -1 for none."""
+    points = view.world_points_m()
+    facade_px = view.facade_pixels()
+    best = np.full(facade_px.shape, np.inf)
+    owner = np.full(facade_px.shape, -1, dtype=np.int64)
+    for k, f in enumerate(facades):
+        d = points @ f.normal - f.offset_m
+        s = points @ f.along
+        on = (facade_px & (d <= config.front_m) & (d >= -config.back_m)
+              & (s >= f.s_range_m[0] - config.pad_m) & (s <= f.s_range_m[1] + config.pad_m)
+              & (points[..., 2] >= f.z_range_m[0] - config.pad_m)
+              & (points[..., 2] <= f.z_range_m[1] + config.pad_m) & (np.abs(d) < best))
+        best[on] = np.abs(d[on])
+        owner[on] = k
+    return owner
+
+
+def cell_votes(facade: FacadePlane, index: int, points_m: np.ndarray, view: PosedView,
+               owners: np.ndarray, config: CellConfig) -> tuple[np.ndarray, np.ndarray]:
+    """One view's votes on the cells at ``points_m`` (M, 3) of ``facades[index]``: the cells'
+    indices (V,) and their votes (V,) (none, wall, window or door), from the view's
+    :func:`pixel_owners` ``owners`` (a pixel on another facade's plane votes "none" behind
+    this plane and nothing in front of it)."""
+    h = float(facade.normal @ view.camera_m) - facade.offset_m  # camera to plane, m
+    if h <= 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    seen = h / np.linalg.norm(view.camera_m - points_m, axis=1) >= config.min_view_cos
+    idx = np.flatnonzero(seen)
+    k = view.intrinsics
+    uv, z = project_world_to_image(points_m[idx], k, view.frame.world_from_camera)
+    inside = (z > 0) & (uv[:, 0] >= 0) & (uv[:, 0] < k.width) & (uv[:, 1] >= 0) & (
+        uv[:, 1] < k.height)
+    idx, uv, z = idx[inside], uv[inside], z[inside]
+    col, row = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
+    d = view.depth_z_m[row, col].astype(np.float64)
+    behind_m = (d / z - 1.0) * h  # how far behind the plane the pixel's surface lies
+    owner = owners[row, col]
+    on_plane = (d > 0) & (behind_m >= -config.front_m) & (behind_m <= config.back_m)
+    elsewhere = on_plane & (owner >= 0) & (owner != index)
+    past = (d <= 0) | (behind_m > config.back_m) | (elsewhere & (behind_m >= 0))
+    mine = on_plane & ~elsewhere
+    vote = np.where(mine & (owner == index), _VOTE_OF_CLASS[view.labels[row, col]], NONE)
+    keep = mine | past
+    return idx[keep], vote[keep]
+
+
+def measure_facades(facades: list[FacadePlane], views: list[PosedView],
+                    config: CellConfig) -> list[CellAreas | None]:
+    """Each facade's class areas by cell voting (module docstring), in the order of
+    ``facades``; ``None`` for one with no wall, window or door cell."""
+    grids = [cell_centres_m(f, config) for f in facades]
+    votes = [np.zeros((len(g[0]), 4), dtype=np.int64) for g in grids]
+    voters = [0] * len(facades)
     for view in views:
-        h = float(facade.normal @ view.camera_m) - facade.offset_m  # camera to plane, m
-        if h <= 0:
-            continue
-        seen = h / np.linalg.norm(view.camera_m - points_m, axis=1) >= config.min_view_cos
-        idx = np.flatnonzero(seen)
-        k = view.intrinsics
-        uv, z = project_world_to_image(points_m[idx], k, view.frame.world_from_camera)
-        inside = (z > 0) & (uv[:, 0] >= 0) & (uv[:, 0] < k.width) & (uv[:, 1] >= 0) & (
-            uv[:, 1] < k.height)
-        idx, uv, z = idx[inside], uv[inside], z[inside]
-        col, row = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
-        d = view.depth_z_m[row, col].astype(np.float64)
-        behind_m = (d / z - 1.0) * h  # how far behind the plane the pixel's surface lies
-        on_plane = (d > 0) & (behind_m >= -config.front_m) & (behind_m <= config.back_m)
-        past = (d <= 0) | (behind_m > config.back_m)
-        vote = np.where(on_plane, _VOTE_OF_CLASS[view.labels[row, col]], NONE)
-        keep = on_plane | past
-        np.add.at(votes, (idx[keep], vote[keep]), 1)
-        voters += bool(np.any(vote[keep] != NONE))
-    return votes, voters
+        owners = pixel_owners(view, facades, config)
+        for k, (facade, (points, _, _)) in enumerate(zip(facades, grids)):
+            idx, vote = cell_votes(facade, k, points, view, owners, config)
+            np.add.at(votes[k], (idx, vote), 1)
+            voters[k] += bool(np.any(vote != NONE))
+    return [_areas(v, g, n, config) for v, g, n in zip(votes, grids, voters)]
 
 
 def measure_facade_cells(facade: FacadePlane, views: list[PosedView],
                          config: CellConfig) -> CellAreas | None:
-    """The facade's class areas by cell voting (module docstring); ``None`` when no cell is
-    wall, window or door."""
-    points, s, z = cell_centres_m(facade, config)
-    votes, voters = cell_votes(facade, points, views, config)
+    """One facade's class areas by cell voting, as if it were the only one."""
+    return measure_facades([facade], views, config)[0]
+
+
+def _areas(votes: np.ndarray, grid: tuple[np.ndarray, np.ndarray, np.ndarray], voters: int,
+           config: CellConfig) -> CellAreas | None:
+    points, s, z = grid
     cls = np.where(votes.sum(axis=1) > 0, np.argmax(votes, axis=1), NONE)
     on = cls != NONE
     if not on.any():

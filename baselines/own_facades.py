@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from baselines.aggregate import Combine, building_result, combine_values
-from baselines.facade_cells import CellAreas, CellConfig, measure_facade_cells
+from baselines.facade_cells import CellAreas, CellConfig, measure_facades
 from baselines.plane_merge import FacadePlane, MergeConfig, merge_view_planes
 from baselines.posed_views import PosedView, PosedViews, load_posed_views
 from baselines.view_planes import PlaneFitConfig, ViewPlane, find_view_planes
@@ -101,11 +101,10 @@ def run_2dss_own(scene: MethodInput, protocol: str, config: OwnFacadesConfig, *,
     """
     start = time.perf_counter()
     found = find_own_facades(scene, protocol, config, seed)
-    measured: list[tuple[FacadePlane, CellAreas]] = []
-    for facade in found.facades:
-        cells = measure_facade_cells(facade, found.loaded.views, config.cells)
-        if cells is not None and cells.areas.gross_m2 >= config.min_facade_area_m2:
-            measured.append((facade, cells))
+    measured: list[tuple[FacadePlane, CellAreas]] = [
+        (facade, cells) for facade, cells in zip(
+            found.facades, measure_facades(found.facades, found.loaded.views, config.cells))
+        if cells is not None and cells.areas.gross_m2 >= config.min_facade_area_m2]
     warnings = list(found.loaded.warnings)
     dropped = len(found.facades) - len(measured)
     if dropped:
