@@ -15,9 +15,11 @@ from baselines.own_facades import find_own_facades
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
 from dataset.core.camera import Intrinsics, look_at
+from dataset.core.classes import SemanticClass
 from dataset.core.truth import Building
 from dataset.generate import GenerateConfig
 from dataset.presets import build_building, preset_recipes
+from dataset.scenes.images import write_labels
 from dataset.scenes.scene import read_method_input, read_scene, write_transforms
 from dataset.scenes.scene_writer import generate_scene
 from metrics.errors import building_errors, facade_errors
@@ -32,14 +34,18 @@ ORBIT = GenerateConfig(resolution=128, views=32, ideal=False, multi=False)  # 16
 
 
 def _synthetic_scene(tmp_path):
-    """Three views of the facade, one of the sky, one without a semantic mask; no facade ids."""
+    """Three views of the facade, one of the sky, one without a semantic mask, one whose mask
+    shows a 5 x 5 px patch of wall (too little for a plane); no facade ids."""
     poses = [facade_pose(L_M, H_M, distance_m=16.0, azimuth_deg=a) for a in (-25.0, 0.0, 25.0)]
     poses.append(look_at([L_M / 2, -16.0, 1.6], [L_M / 2, -16.0 + 1.0, 40.0]))  # the sky
-    poses.append(poses[1])
+    poses += [poses[1], poses[1]]
     s = write_facade_scene(tmp_path / "facade_scene", [(None, p) for p in poses], K,
                            split="train", length_m=L_M, height_m=H_M, windows=WINDOWS)
     frames = list(s.frames)
     frames[4] = replace(frames[4], semantic_file_path=None)
+    patch = np.zeros((K.height, K.width), dtype=np.uint8)
+    patch[60:65, 80:85] = SemanticClass.WALL
+    write_labels(s.path(frames[5].semantic_file_path), patch)
     write_transforms(s.root, replace(s, frames=tuple(frames)))
     return read_method_input(s.root)
 
@@ -55,9 +61,10 @@ def test_2dss_finds_the_one_facade_and_skips_views_with_nothing_usable(tmp_path)
     assert 100 * abs(f.wwr - true_wwr(L_M, H_M, WINDOWS)) < WWR_POINTS
     assert (r.wwr, r.facade_area_m2) == (f.wwr, f.facade_area_m2)
     skipped = [w for w in r.warnings if "skipped" in w]
-    assert len(skipped) == 2
+    assert len(skipped) == 3
     assert any("train_003" in w and "no wall, window or door pixel" in w for w in skipped)
     assert any("train_004" in w and "no semantic_file_path" in w for w in skipped)
+    assert any("train_005" in w and "no vertical facade plane" in w for w in skipped)
 
 
 def test_2ds_groups_the_views_of_one_facade(tmp_path):
@@ -70,8 +77,8 @@ def test_2ds_groups_the_views_of_one_facade(tmp_path):
 
 def test_a_split_without_usable_views_fails_with_the_reasons(tmp_path):
     scene = _synthetic_scene(tmp_path)
-    sky_only = replace(scene, frames=tuple(f for f in scene.frames
-                                           if f.file_path.endswith(("003.png", "004.png"))))
+    sky_only = replace(scene, frames=tuple(
+        f for f in scene.frames if f.file_path.endswith(("003.png", "004.png", "005.png"))))
     with pytest.raises(ValueError, match="nothing left to measure.*no wall, window or door"):
         run_2dss(sky_only, "train")
 
@@ -93,6 +100,8 @@ def test_2dss_on_orbit_views_finds_each_wall_of_the_box_once(box_scene):
     r = run_2dss(read_method_input(box_scene), "train")
     rows = facade_errors(r, truth)
     assert [x.kind for x in rows] == ["matched"] * 4  # one estimate per wall, none elsewhere
+    azimuths = [np.degrees(np.arctan2(f.normal[1], f.normal[0])) % 360 for f in r.facades]
+    assert azimuths == sorted(azimuths) and [f.id for f in r.facades] == [1, 2, 3, 4]
     by_normal = {tuple(np.round(f.normal)): f for f in r.facades}
     for wall in truth.facades:
         est = by_normal[tuple(np.round(wall.normal))]
