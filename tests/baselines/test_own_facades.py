@@ -11,14 +11,20 @@ import pytest
 from baselines_synthetic import facade_pose, true_wwr, window_grid, write_facade_scene
 from conftest import make_box_building
 
-from baselines.own_facades import find_own_facades
+from baselines.facade_cells import measure_facades
+from baselines.own_facades import OwnFacadesConfig, find_own_facades
+from baselines.plane_merge import merge_view_planes
+from baselines.posed_views import PosedView
+from baselines.view_planes import find_view_planes
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
 from dataset.core.camera import Intrinsics, look_at
 from dataset.core.classes import SemanticClass
+from dataset.core.scene_record import Frame
 from dataset.core.truth import Building
 from dataset.generate import GenerateConfig
 from dataset.presets import build_building, preset_recipes
+from dataset.rendering.render import render_ground_truth
 from dataset.scenes.images import write_labels
 from dataset.scenes.scene import read_method_input, read_scene, write_transforms
 from dataset.scenes.scene_writer import generate_scene
@@ -138,3 +144,31 @@ def test_the_two_parallel_walls_of_the_l_shape_are_two_facades(tmp_path):
     walls = [t.id for t in truth.facades if t.normal[0] > 0.99]
     assert len(walls) == 2 and all(x.kind == "matched" for x in rows if x.facade_id in walls)
     assert not [x for x in rows if x.kind == "false_positive"]
+
+
+@pytest.mark.slow
+def test_street_views_along_the_box_find_the_walls_they_see(box_building):
+    # 33 photos from the pavement (eye height, 18 m in front of the -y wall, x from -25 to
+    # 25 m, looking ahead and 30 degrees to either side): the -y wall and both side walls,
+    # each measured once although most photos show two of them; the +y wall is never seen.
+    k = Intrinsics.from_fov(256, 192, 70.0)
+    views = []
+    for x in np.linspace(-25.0, 25.0, 11):
+        for yaw in np.radians([-30.0, 0.0, 30.0]):
+            eye = np.array([x, -18.0, 1.6])
+            pose = look_at(eye, eye + [10 * np.sin(yaw), 10 * np.cos(yaw), 2.0])
+            gt = render_ground_truth(box_building.mesh, k, pose)
+            views.append(PosedView("street", len(views), Frame(f"v{len(views)}.png", pose, k,
+                                                               "train"),
+                                   gt.labels, gt.depth_z_m.astype(np.float32)))
+    config = OwnFacadesConfig()
+    planes = [p for v in views if v.facade_pixels().any()
+              for p in find_view_planes(v, config.fit, np.random.default_rng(v.index))]
+    facades = merge_view_planes(planes, config.merge)
+    measured = measure_facades(facades, views, config.cells)
+    assert len(facades) == 3
+    for facade, cells in zip(facades, measured):
+        wall = max(box_building.truth.facades, key=lambda t: np.dot(t.normal, facade.normal))
+        assert np.degrees(np.arccos(min(1.0, np.dot(wall.normal, facade.normal)))) < NORMAL_DEG
+        assert cells.areas.gross_m2 == pytest.approx(wall.facade_area_m2, rel=AREA_REL)
+        assert 100 * abs(cells.areas.wwr - wall.wwr) < WWR_POINTS
