@@ -22,7 +22,7 @@ from tqdm import tqdm
 from dataset.benchmark_cache import DefaultBenchmark, default_results_folder, ensure_benchmark
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
 from dataset.core.method_input import MethodInput
-from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
 from dataset.core.results import MethodResult, write_result
 from dataset.core.warnings_summary import summarise_warnings
 from dataset.scenes.scene import read_method_input
@@ -88,9 +88,11 @@ def _figure(value: float | None, digits: int) -> str:
 
 def add_common_arguments(parser: argparse.ArgumentParser) -> None:
     """--views, --data, --out, --debug-images and --debug."""
-    parser.add_argument("--views", required=True, choices=VIEW_PROTOCOLS,
-                        help="view protocol: 'ideal' (one perpendicular view per facade) or "
-                             "'multi' (several natural views per facade)")
+    parser.add_argument("--views", required=True, choices=(*VIEW_PROTOCOLS, STREET_PROTOCOL),
+                        help="view protocol: 'ideal' (one perpendicular view per facade), "
+                             "'multi' (several natural views per facade), both aimed at the "
+                             "truth's facades, or 'street' (a street capture, scenes made with "
+                             "--street: the method finds its own facades)")
     parser.add_argument("--data", type=Path, default=None,
                         help="a scene folder (with transforms.json) or a folder of scene folders "
                              "(default: the built-in tiny benchmark of metrics.compare, "

@@ -8,8 +8,9 @@ from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
 from dataset.core.method import Method
 from dataset.core.method_input import MethodInput
-from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
 
+PROTOCOLS_2D = (*VIEW_PROTOCOLS, STREET_PROTOCOL)  # the street capture: their own facades
 LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")
 
 
@@ -20,14 +21,16 @@ def debug_images_2dss(scene: MethodInput, protocol: str, config: Wwr2dssConfig,
 
 
 METHOD_2DS = Method(
-    name="2D-S", inputs=("semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
+    name="2D-S", inputs=("semantics", "depth", "poses"), protocols=PROTOCOLS_2D,
     config_type=Wwr2dsConfig, run=run_2ds, packages=("baselines",), libraries=LIBRARIES,
-    description="per-view window/facade pixel ratio of the semantic mask (Szczesniak et al.)",
+    description="per-view window/facade pixel ratio of the semantic mask (Szczesniak et al.); "
+                "on views without facade ids, views grouped by their dominant depth plane",
     paper_name="2D-S",
 )
 METHOD_2DSS = Method(
-    name="2D-SS", inputs=("rgb", "semantics", "depth", "poses"), protocols=VIEW_PROTOCOLS,
+    name="2D-SS", inputs=("rgb", "semantics", "depth", "poses"), protocols=PROTOCOLS_2D,
     config_type=Wwr2dssConfig, run=run_2dss, packages=("baselines",), libraries=LIBRARIES,
-    description="facade plane by RANSAC, rectified facade, WWR in the rectified mask",
+    description="facade plane by RANSAC, rectified facade, WWR in the rectified mask; on views "
+                "without facade ids, own facades from depth planes measured by cell voting",
     debug_images=debug_images_2dss, paper_name="2D-SS",
 )

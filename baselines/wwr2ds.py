@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import argparse
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Literal
 
@@ -26,6 +26,8 @@ from baselines.aggregate import COMBINES, Combine, building_result, combine_valu
 from baselines.cli import add_common_arguments, main_guarded, run_scenes
 from baselines.debug import colour_labels, write_debug_image
 from baselines.facade_mask import facade_class_mask, isolate_facade_2ds
+from baselines.own_facades import OwnFacadesConfig, run_2ds_own
+from baselines.posed_views import finds_own_facades
 from baselines.views import FacadeView, Protocol, ViewError, load_views
 from dataset.core.classes import SemanticClass
 from dataset.core.cli_errors import check_output_folder
@@ -43,11 +45,13 @@ class Wwr2dsConfig:
 
     ``isolation``: "centre_component" keeps the facade component at the image
     centre; "all" counts every facade pixel of the view. ``combine``: how the
-    views of one facade are combined ("mean" as in the paper, or "median").
+    views of one facade are combined ("mean" as in the paper, or "median"). ``own_facades``:
+    how facades are found on views without facade ids (:mod:`baselines.own_facades`).
     """
 
     isolation: Literal["centre_component", "all"] = "centre_component"
     combine: Combine = "mean"
+    own_facades: OwnFacadesConfig = field(default_factory=OwnFacadesConfig)
 
     def __post_init__(self) -> None:
         if self.isolation not in ("centre_component", "all"):
@@ -109,13 +113,17 @@ def measure_view_2ds(view: FacadeView, config: Wwr2dsConfig) -> tuple[ViewPixels
 
 def run_2ds(scene: MethodInput, protocol: Protocol, config: Wwr2dsConfig = Wwr2dsConfig(), *,
             debug_dir: Path | None = None) -> MethodResult:
-    """2D-S on one scene's ideal or multi views.
+    """2D-S on one scene's ideal or multi views; on views without facade ids (``train``) it
+    groups the views into its own facades (:func:`baselines.own_facades.run_2ds_own`).
 
     Raises
     ------
     ValueError
         If the protocol is unknown, the scene has no such views, or no view is usable.
     """
+    if finds_own_facades(scene, protocol):
+        return run_2ds_own(scene, protocol, config.own_facades, combine=config.combine,
+                           method=METHOD, method_config=asdict(config))
     start = time.perf_counter()
     loaded = load_views(scene, protocol, depth="optional")
     per_facade: dict[int, list[ViewPixels2ds]] = {fid: [] for fid in loaded.facade_ids}

@@ -53,6 +53,8 @@ from baselines.facade_mask import (
     isolate_facade_on_plane,
     tolerance_for_depth_steps,
 )
+from baselines.own_facades import OwnFacadesConfig, run_2dss_own
+from baselines.posed_views import finds_own_facades
 from baselines.rectify import (
     OUTSIDE,
     quadrilateral_area_px,
@@ -90,7 +92,8 @@ class Wwr2dssConfig:
     of a corner of the back-projected quadrilateral before the upright bounding
     rectangle replaces it. ``min_rectangle_fill``: a facade whose mask outline covers
     less than this share of its L x H rectangle is measured by the outline's area
-    (0 keeps L x H always). ``seed``: RANSAC randomness.
+    (0 keeps L x H always). ``seed``: RANSAC randomness. ``own_facades``: how facades are
+    found and measured on views without facade ids (:mod:`baselines.own_facades`).
     """
 
     weighting: Literal["alpha", "area"] = "alpha"
@@ -104,6 +107,7 @@ class Wwr2dssConfig:
     max_corner_angle_error_deg: float = 5.0
     min_rectangle_fill: float = 0.95
     seed: int = 0
+    own_facades: OwnFacadesConfig = field(default_factory=OwnFacadesConfig)
 
     def __post_init__(self) -> None:
         if self.weighting not in ("alpha", "area"):
@@ -237,13 +241,17 @@ def rectify_views(geometries: list[ViewGeometry], config: Wwr2dssConfig,
 
 def run_2dss(scene: MethodInput, protocol: Protocol, config: Wwr2dssConfig = Wwr2dssConfig(), *,
              debug_dir: Path | None = None, device: torch.device | str = "cpu") -> MethodResult:
-    """2D-SS on one scene's ideal or multi views.
+    """2D-SS on one scene's ideal or multi views; on views without facade ids (``train``)
+    it finds its own facades (:func:`baselines.own_facades.run_2dss_own`, no debug images).
 
     Raises
     ------
     ValueError
         If the protocol is unknown, the scene has no such views, or no view is usable.
     """
+    if finds_own_facades(scene, protocol):
+        return run_2dss_own(scene, protocol, config.own_facades, seed=config.seed,
+                            method=METHOD, method_config=asdict(config))
     start = time.perf_counter()
     loaded = load_views(scene, protocol, depth="required")
     geometries: list[ViewGeometry] = []

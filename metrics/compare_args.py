@@ -64,9 +64,12 @@ def parse_compare_args(argv: Sequence[str] | None,
     parser.add_argument("--methods", default=",".join(METHODS),
                         help=f"comma-separated methods (default: {','.join(METHODS)})")
     parser.add_argument("--views", default=",".join(VIEW_PROTOCOLS),
-                        help="comma-separated facade-view protocols of the methods that run "
-                        f"on them (default: {','.join(VIEW_PROTOCOLS)}); a method on the orbit "
-                        "views always uses those")
+                        help="comma-separated view protocols of the methods that run on them: "
+                        "ideal, multi (aimed at the truth's facades, as in the paper), street "
+                        "(a street capture placed without the truth, scenes made with "
+                        f"--street; the 2D methods find their own facades) (default: "
+                        f"{','.join(VIEW_PROTOCOLS)}); a method on the orbit views always uses "
+                        "those")
     parser.add_argument("--results", type=Path,
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,

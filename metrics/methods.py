@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from dataset.core.method import BUILT_IN, Method, built_in_method, installed_methods
-from dataset.core.protocols import VIEW_PROTOCOLS
+from dataset.core.protocols import SELECTABLE_PROTOCOLS
 from dataset.core.results import MethodResult
 from dataset.executors.ray_tasks import TaskResources
 from dataset.scenes.scene import read_method_input
@@ -72,12 +72,12 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
                      config: Any = None) -> MethodSpec:
     """The spec of ``method`` run with ``config`` (``None``: its config type's default).
 
-    It runs on the protocols it declares: of the view protocols, those in
-    ``views``; others (``train``) always. A method with an ``artefacts`` folder
+    It runs on the protocols it declares: of the selectable ones (ideal, multi, street), those
+    in ``views``; others (``train``) always. A method with an ``artefacts`` folder
     keeps it under ``results_dir`` (a seed other than 0 in ``seed<k>/`` below it).
     """
     config = method.config_type() if config is None else config
-    protocols = tuple(p for p in method.protocols if p not in VIEW_PROTOCOLS or p in views)
+    protocols = tuple(p for p in method.protocols if p not in SELECTABLE_PROTOCOLS or p in views)
     seed = config.seed if _has_seed(config) else None
     artefacts_dir = results_dir / method.artefacts if method.artefacts else None
     if artefacts_dir is not None and seed:
@@ -132,8 +132,9 @@ def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> dict[str, Me
     if not names:
         raise ValueError(f"no method given; choose from {', '.join(METHODS)}")
     for view in views:
-        if view not in VIEW_PROTOCOLS:
-            raise ValueError(f"unknown views {view!r}; choose from {', '.join(VIEW_PROTOCOLS)}")
+        if view not in SELECTABLE_PROTOCOLS:
+            raise ValueError(f"unknown views {view!r}; choose from "
+                             f"{', '.join(SELECTABLE_PROTOCOLS)}")
     plugins = installed_methods() if any(n not in METHODS for n in names) else {}
     for name in names:
         if name not in METHODS and name not in plugins:

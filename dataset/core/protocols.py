@@ -2,8 +2,10 @@
 
 ``ideal``: one fronto-parallel view per facade; ``multi``: five oblique views
 per facade (both carry the truth's facade ids, so a result's facades are the
-truth's); ``train``: the orbit training views (neural3d numbers its own
-facades). The names are also the scene's frame splits (:data:`Split`).
+truth's); ``train``: the orbit training views, and ``street``: the frames a car takes from
+the road (``--street``, :mod:`dataset.rendering.street_views`), which carry no facade id
+(neural3d, and the 2D methods, number their own facades on them:
+:data:`OWN_FACADE_PROTOCOLS`). The names are also the scene's frame splits (:data:`Split`).
 """
 
 from __future__ import annotations
@@ -12,19 +14,24 @@ from typing import Literal, get_args
 
 ViewProtocol = Literal["ideal", "multi"]
 """The facade-view protocols of the 2D methods."""
-Protocol = Literal["ideal", "multi", "train"]
+Protocol = Literal["ideal", "multi", "train", "street"]
 """Every protocol a result may name."""
 
 VIEW_PROTOCOLS: tuple[ViewProtocol, ...] = get_args(ViewProtocol)
 IDEAL_PROTOCOL, MULTI_PROTOCOL = VIEW_PROTOCOLS
 TRAIN_PROTOCOL: Protocol = "train"
-Split = Literal[Protocol, "eval", "street"]
-"""A scene frame's split: a protocol's views, ``eval``: held-out orbit views no method runs
-on (neural3d evaluates its renders on them), or ``street``: the frames a car takes from the
-road (``--street``, :mod:`dataset.rendering.street_views`; placed and named without the
-truth: no ``facade_id``; no method reads them yet)."""
+STREET_PROTOCOL: Protocol = "street"
+OWN_FACADE_PROTOCOLS: tuple[Protocol, ...] = (TRAIN_PROTOCOL, STREET_PROTOCOL)
+"""Protocols of posed views without facade ids, on which the 2D methods find the facades
+themselves (:mod:`baselines.own_facades`)."""
+SELECTABLE_PROTOCOLS: tuple[Protocol, ...] = (*VIEW_PROTOCOLS, STREET_PROTOCOL)
+"""The protocols a comparison runs a method on only when asked (``--views``); the others
+(``train``) always, for a method that declares them."""
+Split = Literal[Protocol, "eval"]
+"""A scene frame's split: a protocol's views, or ``eval``: held-out orbit views no method runs
+on (neural3d evaluates its renders on them)."""
 EVAL_SPLIT: Split = "eval"
-STREET_SPLIT: Split = "street"
+STREET_SPLIT: Split = STREET_PROTOCOL
 SPLITS: tuple[Split, ...] = get_args(Split)
 PROTOCOLS: tuple[Protocol, ...] = get_args(Protocol)
 """Every protocol, in the tables' order."""

@@ -78,7 +78,9 @@ def test_run_averages_views_then_facades_and_reports_missing(tmp_path):
     assert r.facade_area_m2 == pytest.approx(f1.facade_area_m2 + f2.facade_area_m2)
     assert any("skipped" in w and "no semantic_file_path" in w for w in r.warnings)
     assert (tmp_path / "dbg" / "facade_scene__ideal__f2__v1__mask.png").is_file()
-    assert r.config == {"isolation": "centre_component", "combine": "mean"}
+    assert {k: r.config[k] for k in ("isolation", "combine")} == {
+        "isolation": "centre_component", "combine": "mean"}
+    assert r.config["own_facades"]["cells"]["cell_m"] == Wwr2dsConfig().own_facades.cells.cell_m
 
 
 def test_cli_writes_one_result_per_scene(tmp_path, capsys):
