@@ -58,15 +58,16 @@ def evaluate_set(photos: Sequence[RealPhoto], segmenter: Segmenter,
 
 def report_markdown(results: dict[str, dict[str, list[PhotoResult]]], segmenter: Segmenter,
                     command: str, roots: dict[str, Path], seconds: tuple[float, float],
-                    threads: int) -> str:
-    """The Markdown report of :func:`evaluate_set` results of each set (module doc)."""
+                    threads: int, started: tuple[str, str]) -> str:
+    """The Markdown report of :func:`evaluate_set` results of each set (module doc);
+    ``started`` is (UTC time, code version) at the start of the run."""
     wall_s, cpu_s = seconds
-    when = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    when, code = started
     ident = ", ".join(f"{k} {v}" for k, v in segmenter.identity.items())
     lines = [
         "# The segmenter on labelled real photos", "",
         "Written by:", "", "```bash", command, "```", "",
-        f"{when}, code `{code_version()}`, segmenter `{segmenter.name}` ({ident}); "
+        f"{when}, code `{code}`, segmenter `{segmenter.name}` ({ident}); "
         f"{threads} torch thread(s), {wall_s:.0f} s wall, {cpu_s:.0f} s CPU. Each photo is "
         f"segmented once at its own size; its split comes from the committed lists "
         f"(`segment/real_sets/splits/`); nothing is tuned on these photos. Definitions: "
@@ -152,13 +153,15 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ValueError(f"--max-photos must be >= 1, got {args.max_photos}")
         sets = {name: read_set(name, root) for name, root in roots.items()}
         segmenter = resolve_segmenter(args.model, threads=args.threads)
+        started = (datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"), code_version())
         start_wall, start_cpu = time.perf_counter(), time.process_time()
         results = {name: evaluate_set(photos, segmenter, args.max_photos)
                    for name, photos in sets.items()}
         seconds = (time.perf_counter() - start_wall, time.process_time() - start_cpu)
         command = "python -m segment.evaluate_real " + shlex.join(
             sys.argv[1:] if argv is None else list(argv))
-        text = report_markdown(results, segmenter, command, roots, seconds, args.threads)
+        text = report_markdown(results, segmenter, command, roots, seconds, args.threads,
+                               started)
         write_text_atomic(args.out, text)
         print(text, end="")
         return 0
