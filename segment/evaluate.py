@@ -21,9 +21,9 @@ from dataset.core.atomic import write_text_atomic
 from dataset.core.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
 from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
 from dataset.core.scene_record import Scene
-from segment.photo_io import read_photo_rgb
 from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_validation import read_frame_labels
+from segment.photo_io import read_photo_rgb
 from segment.scene_masks import scene_folders
 from segment.segmenter import Segmenter, resolve_segmenter, segment_rgb
 

@@ -26,8 +26,14 @@ from dataset.core.classes import CLASS_NAMES
 from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
 from dataset.core.provenance import code_version
 from segment.evaluate import evenly_spaced
-from segment.real_measure import (WWR_BANDS_POINTS, PhotoResult, photo_result, predicted_as,
-                                  split_scores, wwr_scores)
+from segment.real_measure import (
+    WWR_BANDS_POINTS,
+    PhotoResult,
+    photo_result,
+    predicted_as,
+    split_scores,
+    wwr_scores,
+)
 from segment.real_sets import SET_NAMES, RealPhoto, cmp, labelmefacade, read_set
 from segment.real_sets.splits import SPLITS, committed_splits, split_of
 from segment.segmenter import Segmenter, resolve_segmenter

@@ -116,7 +116,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     def body() -> int:
         given = {n: getattr(args, n) for n in SET_NAMES if getattr(args, n) is not None}
         if not given:
-            raise ValueError(f"give at least one set folder ({', '.join('--' + n for n in SET_NAMES)})")
+            flags = ", ".join(f"--{n}" for n in SET_NAMES)
+            raise ValueError(f"give at least one set folder ({flags})")
         for name, root in given.items():
             photos = read_set(name, root)
             write_text_atomic(args.out / f"{name}.csv", split_list_text(photos))
