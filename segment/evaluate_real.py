@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from datetime import datetime, timezone
 from pathlib import Path
 
+import numpy as np
 from tqdm import tqdm
 
 from dataset.core.atomic import write_text_atomic
@@ -29,7 +30,9 @@ from segment.evaluate import evenly_spaced
 from segment.real_measure import (
     WWR_BANDS_POINTS,
     PhotoResult,
+    mean_labels_wwr,
     photo_result,
+    photo_rows_csv,
     predicted_as,
     split_scores,
     wwr_scores,
@@ -105,18 +108,24 @@ def report_markdown(results: dict[str, dict[str, list[PhotoResult]]], segmenter:
         lines += ["", "## WWR on the rectified CMP facades", "",
                   "A 2D-S-style ratio, window / (wall + window + door) pixels, of the "
                   "predicted mask against the same ratio of the labels, over the pixels the "
-                  "labels count; error in percentage points (predicted minus labels).", "",
-                  f"| split | facades | labels' WWR, mean | predicted WWR, mean | mean "
-                  f"absolute error (points) | mean error (points) | {bands} |",
-                  "|---|---|---|---|---|---|" + "---|" * len(WWR_BANDS_POINTS)]
+                  "labels count; error in percentage points (answer minus labels). Beside "
+                  "it, a constant answer for every facade: the mean WWR of the train "
+                  "split's labels (what a ratio reading nothing of the photo achieves).", "",
+                  f"| split | answer | facades | labels' WWR, mean | answer's WWR, mean | "
+                  f"mean absolute error (points) | mean error (points) | {bands} |",
+                  "|---|---|---|---|---|---|---|" + "---|" * len(WWR_BANDS_POINTS)]
+        constant = mean_labels_wwr(results[cmp.SET_NAME].get("train") or [])
         for split, rows in results[cmp.SET_NAME].items():
             if not rows:
                 continue
-            w = wwr_scores(rows)
-            shares = " | ".join(f"{w.within_points[b]:.0%}" for b in WWR_BANDS_POINTS)
-            lines.append(f"| {split} | {w.facades} | {w.labels_mean:.3f} | "
-                         f"{w.predicted_mean:.3f} | **{w.mean_abs_error_points:.1f}** | "
-                         f"{w.mean_error_points:+.1f} | {shares} |")
+            answers = [("predicted masks", wwr_scores(rows))]
+            if np.isfinite(constant):
+                answers.append((f"constant {constant:.3f}", wwr_scores(rows, constant)))
+            for what, w in answers:
+                shares = " | ".join(f"{w.within_points[b]:.0%}" for b in WWR_BANDS_POINTS)
+                lines.append(f"| {split} | {what} | {w.facades} | {w.labels_mean:.3f} | "
+                             f"{w.predicted_mean:.3f} | **{w.mean_abs_error_points:.1f}** | "
+                             f"{w.mean_error_points:+.1f} | {shares} |")
     lines += ["", "## What the labels' window pixels are predicted as", "",
               "| set | split | " + " | ".join(CLASS_NAMES) + " |",
               "|---|---|" + "---|" * len(CLASS_NAMES)]
@@ -145,6 +154,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--model", default=None,
                         help="'default', a weights file (*.pt) or a segmenter plugin "
                         "(default: default)")
+    parser.add_argument("--csv", type=Path,
+                        help="also write one line per photo (window IoU, precision, recall, "
+                        "WWR of the labels and of the prediction) to this CSV file")
     parser.add_argument("--max-photos", type=int, default=None,
                         help="evenly spaced photos per set and split (default: all)")
     parser.add_argument("--threads", type=int, default=2, help="torch threads (default: 2)")
@@ -169,6 +181,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         text = report_markdown(results, segmenter, command, roots, seconds, args.threads,
                                started)
         write_text_atomic(args.out, text)
+        if args.csv is not None:
+            write_text_atomic(args.csv, photo_rows_csv(results))
         print(text, end="")
         return 0
 

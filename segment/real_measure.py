@@ -14,7 +14,9 @@ ratio 2D-S takes on a rectified facade view, over the pixels the labels count (b
 masks over the same pixels: a shop front, unlabelled by the project's classes, is out of
 both). On the CMP facades, which are rectified, the ratio of the predicted mask is
 compared with the ratio of the labels: the error in percentage points per facade, its
-mean absolute value and mean, and the share of facades within 5 and 10 points.
+mean absolute value and mean, and the share of facades within 5 and 10 points; beside it
+the same errors of a constant answer, the mean WWR of the train split's labels, for every
+facade: what a ratio that reads nothing of the photo achieves.
 """
 
 from __future__ import annotations
@@ -111,10 +113,14 @@ def split_scores(results: Sequence[PhotoResult]) -> SplitScores:
                        float(iou[SemanticClass.BACKGROUND]))
 
 
-def wwr_scores(results: Sequence[PhotoResult]) -> WwrScores:
-    """WWR errors over the photos where both ratios exist."""
-    pairs = np.array([(r.wwr_labels, r.wwr_predicted) for r in results
-                      if np.isfinite(r.wwr_labels) and np.isfinite(r.wwr_predicted)])
+def wwr_scores(results: Sequence[PhotoResult], constant: float | None = None) -> WwrScores:
+    """WWR errors over the photos where both the labels' and the answer's ratio exist (a
+    predicted mask without facade pixels has none); the answer is the predicted masks'
+    ratio, or with ``constant`` that one WWR for every photo (a reference that reads
+    nothing of the photo)."""
+    answer = [r.wwr_predicted if constant is None else constant for r in results]
+    pairs = np.array([(r.wwr_labels, a) for r, a in zip(results, answer)
+                      if np.isfinite(r.wwr_labels) and np.isfinite(a)]).reshape(-1, 2)
     if len(pairs) == 0:
         nan = float("nan")
         return WwrScores(0, nan, nan, nan, nan, {b: nan for b in WWR_BANDS_POINTS})
@@ -129,3 +135,25 @@ def predicted_as(results: Sequence[PhotoResult]) -> np.ndarray:
     row = sum(r.confusion[WINDOW] for r in results)
     total = row.sum() if len(results) else 0
     return row / total if total else np.full(NUM_CLASSES, np.nan)
+
+
+def mean_labels_wwr(results: Sequence[PhotoResult]) -> float:
+    """Mean of the labels' WWR over the photos that have one (NaN if none)."""
+    values = [r.wwr_labels for r in results if np.isfinite(r.wwr_labels)]
+    return float(np.mean(values)) if values else float("nan")
+
+
+def photo_rows_csv(results: dict[str, dict[str, list[PhotoResult]]]) -> str:
+    """CSV text, one line per photo: set, split, name, window IoU, precision, recall, and
+    the labels' and the predicted WWR (empty where undefined)."""
+    lines = ["set,split,name,window_iou,window_precision,window_recall,wwr_labels,"
+             "wwr_predicted"]
+    for set_name, per_split in results.items():
+        for split, rows in per_split.items():
+            for r in rows:
+                iou = iou_per_class(r.confusion)[WINDOW]
+                precision, recall = window_precision_recall(r.confusion)
+                values = (iou, precision, recall, r.wwr_labels, r.wwr_predicted)
+                lines.append(f"{set_name},{split},{r.name}," + ",".join(
+                    "" if np.isnan(v) else f"{v:.4f}" for v in values))
+    return "\n".join(lines) + "\n"

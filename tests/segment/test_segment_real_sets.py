@@ -146,6 +146,8 @@ def test_measures_on_a_cmp_facade_are_the_closed_form(tmp_path):
     error = (result.wwr_predicted - result.wwr_labels) * 100
     assert wwr.mean_abs_error_points == pytest.approx(abs(error))
     assert wwr.within_points == {5.0: float(abs(error) <= 5), 10.0: float(abs(error) <= 10)}
+    guess = wwr_scores([result], constant=0.25)
+    assert guess.mean_error_points == pytest.approx((0.25 - expected_cmp_wwr()) * 100)
     assert np.isnan(facade_wwr(np.zeros((3, 3), np.uint8)))
 
 
@@ -160,10 +162,16 @@ def test_evaluate_set_takes_the_committed_splits(tmp_path):
 
 def test_evaluate_real_writes_the_report(tmp_path, capsys):
     lmf, cmp = write_labelmefacade(tmp_path / "lmf"), write_cmp(tmp_path / "cmp")
-    out = tmp_path / "report.md"
+    out, per_photo = tmp_path / "report.md", tmp_path / "photos.csv"
     assert main(["--labelmefacade", str(lmf), "--cmp", str(cmp), "--out", str(out),
-                 "--max-photos", "1", "--threads", "1"]) == 0
+                 "--csv", str(per_photo), "--max-photos", "1", "--threads", "1"]) == 0
     text = out.read_text()
+    rows = list(csv.DictReader(io.StringIO(per_photo.read_text())))
+    assert len(rows) == 6 and {r["set"] for r in rows} == {"labelmefacade", "cmp"}
+    cmp_wwr = {float(r["wwr_labels"]) for r in rows if r["set"] == "cmp"}
+    assert cmp_wwr == {round(expected_cmp_wwr(), 4)}
+    # The constant answer is the train facades' mean labels' WWR (all facades alike here).
+    assert f"| test | constant {expected_cmp_wwr():.3f} | 1 |" in text
     assert "python -m segment.evaluate_real --labelmefacade" in text
     for row in ("| labelmefacade | test | 1 |", "| labelmefacade | val | 1 |",
                 "| cmp | test | 1 |", "| cmp | train | 1 |"):
