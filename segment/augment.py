@@ -1,10 +1,14 @@
-"""Training-time augmentation of one (RGB, labels) frame: scale, crop, flip, colour, blur,
-noise and JPEG compression, so that the segmenter learns shapes and context rather than
-the renderer's exact colours and sharpness.
+"""Training-time augmentation of one (RGB, labels) frame: scale, crop, flip, perspective,
+occluders, shadows, colour, blur, noise and JPEG compression, so that the segmenter learns
+shapes and context rather than the renderer's exact colours and sharpness.
 
-Geometry (scale, crop, flip) moves RGB and labels together (labels by nearest
-neighbour); photometric changes touch the RGB only. Pixels that a crop takes from
-outside the image get the label :data:`IGNORE_LABEL`, which the loss skips.
+Geometry (scale, crop, flip, perspective) moves RGB and labels together (labels by
+nearest neighbour); photometric changes (shadows included) touch the RGB only; an
+occluder (a pole, trunk or sign in front of the facade) paints both, its pixels
+labelled background as the real sets label what hides a facade. Pixels that a crop or a
+warp takes from outside the image get the label :data:`IGNORE_LABEL`, which the loss
+skips. Perspective, occluders and shadows are off by default (the render training's
+recipe); :data:`REAL_PHOTO_AUGMENT` turns them on for training on real photos.
 """
 
 from __future__ import annotations
@@ -31,7 +35,12 @@ class AugmentConfig:
     ``brightness``, ``contrast``, ``saturation``, ``channel_gain``, ``gamma``: (min, max)
     factors. ``blur_p`` / ``blur_sigma_px``, ``noise_p`` / ``noise_sigma``, ``jpeg_p`` /
     ``jpeg_quality``: probability and range of Gaussian blur, Gaussian noise (in units of
-    full scale) and JPEG re-compression.
+    full scale) and JPEG re-compression. ``perspective_p`` / ``perspective_share``: a
+    homography moving each crop corner by up to that share of the crop side (a camera not
+    square to the facade). ``occluder_p`` / ``occluder_width_share``: one vertical bar of
+    a random flat colour, that share of the crop wide, labelled background. ``shadow_p``
+    / ``shadow_gain``: the RGB beyond a random straight edge (soft, a few pixels) times a
+    gain in that range (a cast shadow).
     """
 
     crop_px: int = 128
@@ -49,6 +58,12 @@ class AugmentConfig:
     noise_sigma: tuple[float, float] = (0.0, 0.04)
     jpeg_p: float = 0.3
     jpeg_quality: tuple[int, int] = (40, 95)
+    perspective_p: float = 0.0
+    perspective_share: float = 0.12
+    occluder_p: float = 0.0
+    occluder_width_share: tuple[float, float] = (0.04, 0.2)
+    shadow_p: float = 0.0
+    shadow_gain: tuple[float, float] = (0.35, 0.8)
 
     def __post_init__(self) -> None:
         if self.crop_px < 8 or not 0 < self.scale[0] <= self.scale[1]:
@@ -72,7 +87,56 @@ def augment_frame(rgb: np.ndarray, labels: np.ndarray, config: AugmentConfig,
     rgb, labels = _scaled_crop(rgb, labels, config, rng)
     if rng.uniform() < config.flip_p:
         rgb, labels = rgb[:, ::-1], labels[:, ::-1]
-    return _photometric(np.ascontiguousarray(rgb), config, rng), labels.astype(np.int64)
+    rgb, labels = np.ascontiguousarray(rgb), np.ascontiguousarray(labels)
+    # A change that is off draws nothing: the render recipe's random sequence is unchanged.
+    if config.perspective_p and rng.uniform() < config.perspective_p:
+        rgb, labels = _perspective(rgb, labels, config.perspective_share, rng)
+    if config.occluder_p and rng.uniform() < config.occluder_p:
+        rgb, labels = _occluder(rgb, labels, config.occluder_width_share, rng)
+    x = _photometric(rgb, config, rng)
+    return x, labels.astype(np.int64)
+
+
+def _perspective(rgb: np.ndarray, labels: np.ndarray, share: float,
+                 rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Warp a square crop by a homography that moves each corner by up to ``share`` of its
+    side; pixels from outside the crop are black, and every pixel they reach (bilinear
+    blending included) is :data:`IGNORE_LABEL`."""
+    side = labels.shape[0]
+    corners = np.float32([[0, 0], [side, 0], [side, side], [0, side]])
+    moved = corners + rng.uniform(-share, share, (4, 2)).astype(np.float32) * side
+    h = cv2.getPerspectiveTransform(corners, moved)
+    size = (labels.shape[1], labels.shape[0])
+    warp = dict(borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    out_rgb = cv2.warpPerspective(rgb, h, size, flags=cv2.INTER_LINEAR, **warp)
+    out_labels = cv2.warpPerspective(labels, h, size, flags=cv2.INTER_NEAREST, **warp)
+    inside = cv2.warpPerspective(np.full(labels.shape, 255, np.uint8), h, size,
+                                 flags=cv2.INTER_LINEAR, **warp)
+    out_labels[inside < 255] = IGNORE_LABEL  # a pixel any outside colour reached
+    return out_rgb, out_labels
+
+
+def _occluder(rgb: np.ndarray, labels: np.ndarray, width_share: tuple[float, float],
+              rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A full-height vertical bar of one random colour, labelled background."""
+    w = labels.shape[1]
+    width = max(1, int(round(rng.uniform(*width_share) * w)))
+    left = int(rng.integers(0, max(1, w - width + 1)))
+    rgb, labels = rgb.copy(), labels.copy()
+    rgb[:, left:left + width] = rng.integers(0, 256, 3, dtype=np.uint8)
+    labels[:, left:left + width] = SemanticClass.BACKGROUND
+    return rgb, labels
+
+
+def _shadow(x: np.ndarray, gain: tuple[float, float], rng: np.random.Generator) -> np.ndarray:
+    """(H, W, 3) float RGB times a gain beyond a random straight edge, blended over ~3 px."""
+    h, w = x.shape[:2]
+    angle = rng.uniform(0, 2 * np.pi)
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    cy, cx = rng.uniform(0, h), rng.uniform(0, w)
+    distance = (xx - cx) * np.cos(angle) + (yy - cy) * np.sin(angle)
+    inside = np.clip(0.5 + distance / 3.0, 0.0, 1.0)[..., None]
+    return x * (1.0 - inside * (1.0 - rng.uniform(*gain)))
 
 
 def _scaled_crop(rgb: np.ndarray, labels: np.ndarray, config: AugmentConfig,
@@ -110,6 +174,8 @@ def _photometric(rgb: np.ndarray, config: AugmentConfig,
         if ok:
             rgb = cv2.imdecode(buf, cv2.IMREAD_COLOR)[..., ::-1]
     x = rgb.astype(np.float32) / 255.0
+    if config.shadow_p and rng.uniform() < config.shadow_p:
+        x = _shadow(x, config.shadow_gain, rng).astype(np.float32)
     if rng.uniform() < config.blur_p:
         x = cv2.GaussianBlur(x, (0, 0), float(rng.uniform(*config.blur_sigma_px)))
     grey = x.mean(axis=2, keepdims=True)
@@ -122,3 +188,10 @@ def _photometric(rgb: np.ndarray, config: AugmentConfig,
     if rng.uniform() < config.noise_p:
         x = x + rng.normal(0.0, rng.uniform(*config.noise_sigma), x.shape).astype(np.float32)
     return np.clip(x, 0.0, 1.0).astype(np.float32)
+
+
+REAL_PHOTO_AUGMENT = AugmentConfig(
+    brightness=(0.5, 1.6), channel_gain=(0.8, 1.2), perspective_p=0.5, occluder_p=0.25,
+    shadow_p=0.3)
+"""Augmentation for training on real photos (:mod:`segment.train` with real sets): wider
+exposure and white balance than the render recipe, perspective, occluders and shadows."""

@@ -123,9 +123,15 @@ def validation_scenes(record: dict[str, Any], folders: Sequence[Path]) -> list[T
     Raises
     ------
     ValueError
-        If the record names no validation building or none of them is in ``folders``.
+        If the record names no validation building or none of them is in ``folders``, or
+        the weights were picked on real photos (:mod:`segment.real_training`).
     """
-    wanted = {(v["scene"], v.get("resolution")): v for v in record.get("validated_on") or []}
+    validated = record.get("validated_on") or []
+    if any("set" in v for v in validated):
+        raise ValueError("these weights were picked on real validation photos (trained with "
+                         "--labelmefacade/--cmp): an offset chosen on the render validation "
+                         "buildings would be chosen off their domain; they are not calibrated")
+    wanted = {(v["scene"], v.get("resolution")): v for v in validated}
     if not wanted:
         raise ValueError("these weights record no validation buildings to calibrate on; "
                          "train them with `python -m segment.train` (it keeps every "

@@ -21,9 +21,9 @@ from dataset.core.atomic import write_text_atomic
 from dataset.core.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
 from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
 from dataset.core.scene_record import Scene
-from dataset.scenes.images import read_rgb
 from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_validation import read_frame_labels
+from segment.photo_io import read_photo_rgb
 from segment.scene_masks import scene_folders
 from segment.segmenter import Segmenter, resolve_segmenter, segment_rgb
 
@@ -94,7 +94,7 @@ def segmenter_scene_iou(scene: Scene, segmenter: Segmenter,
     frames = evenly_spaced([f for f in scene.frames if f.semantic_file_path], max_frames)
     confusion = np.zeros((NUM_CLASSES, NUM_CLASSES), np.int64)
     for fr in frames:
-        labels = segment_rgb(segmenter, read_rgb(scene.path(fr.file_path)))
+        labels = segment_rgb(segmenter, read_photo_rgb(scene.path(fr.file_path)))
         confusion += confusion_matrix(labels, read_frame_labels(scene, fr))
     return SceneIou(scene.root.name, _family(scene), len(frames), confusion)
 

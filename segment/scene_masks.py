@@ -35,8 +35,9 @@ from dataset.core.provenance import (
 )
 from dataset.core.scene_record import Frame
 from dataset.degrade.scene_copy import link_tree
-from dataset.scenes.images import read_rgb, write_labels
+from dataset.scenes.images import write_labels
 from dataset.scenes.scene import read_scene, write_transforms
+from segment.photo_io import read_photo_rgb
 from segment.segmenter import Segmenter, segment_rgb
 
 RECORD_KEY = "predicted_masks"
@@ -123,7 +124,7 @@ def stored_masks_changes(scene_dir: Path, current: Provenance) -> list | None:
 
 
 def _predict_frame(source_root: Path, tmp: Path, fr: Frame, segmenter: Segmenter) -> Frame:
-    rgb = read_rgb(source_root / fr.file_path)
+    rgb = read_photo_rgb(source_root / fr.file_path)
     size = (fr.intrinsics.height, fr.intrinsics.width)
     if rgb.shape[:2] != size:
         raise ValueError(f"{source_root / fr.file_path} is {rgb.shape[1]}x{rgb.shape[0]} px but "

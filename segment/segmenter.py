@@ -27,6 +27,7 @@ import torch
 from dataset.core.classes import CLASS_NAMES, NUM_CLASSES
 from dataset.core.provenance import code_fingerprint, file_fingerprint, library_version
 from segment.network import UNet
+from segment.photo_io import read_photo_rgb
 from segment.weights import DEFAULT_WEIGHTS, load_network
 
 ENTRY_POINT_GROUP = "envelope_bench.segmenters"
@@ -175,6 +176,19 @@ def segment_rgb(segmenter: Segmenter, rgb: np.ndarray) -> np.ndarray:
         raise ValueError(f"{what} class id {int(labels.max())}; ids must be 0..{NUM_CLASSES - 1} "
                          f"({', '.join(f'{i} {n}' for i, n in enumerate(CLASS_NAMES))})")
     return labels
+
+
+def segment_photo(segmenter: Segmenter, path: str | Path) -> np.ndarray:
+    """Read the photo at ``path`` (:func:`segment.photo_io.read_photo_rgb`: upright, 8-bit
+    RGB from grey, 16-bit, CMYK, palette or alpha images) and segment it: (H, W) uint8
+    class ids of the upright image.
+
+    Raises
+    ------
+    ValueError
+        An unreadable file (truncated, corrupt, floating-point) or a bad segmenter answer.
+    """
+    return segment_rgb(segmenter, read_photo_rgb(path))
 
 
 def _plugin(ep: EntryPoint) -> Segmenter:

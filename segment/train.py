@@ -1,20 +1,25 @@
-"""``python -m segment.train``: train the segmenter on renders of buildings never evaluated.
+"""``python -m segment.train``: train the segmenter on renders of buildings never evaluated,
+and on labelled real photos if given.
 
 Stages: load the training scenes (refusing evaluated presets) and split them by
-building into train and validation; measure class weights; run ``steps`` optimiser
-steps on augmented crops (AdamW, one-cycle learning rate), validating the window IoU
-on the validation buildings every ``validate_every`` steps; write the weights of the
-best validation step (the highest mean IoU of background, wall and window: the classes a
-facade measurement reads) with their training record (data, seeds, config, code
-fingerprints, libraries, wall time) atomically. Ctrl-C writes nothing.
+building into train and validation; with real sets (``--labelmefacade``, ``--cmp``),
+load their ``train`` and ``val`` photos from the committed split lists
+(:mod:`segment.real_training`; ``test`` photos are never read); measure class weights;
+run ``steps`` optimiser steps on augmented crops (AdamW, one-cycle learning rate; with
+real sets a ``real_share`` of each batch is real crops, and every crop takes
+:data:`segment.augment.REAL_PHOTO_AUGMENT`), validating every ``validate_every`` steps;
+write the weights of the best validation step (the highest mean IoU of background, wall
+and window: the classes a facade measurement reads; on the real validation photos when
+real sets are given, else on the validation buildings) with their training record (data,
+seeds, config, code fingerprints, libraries, wall time) atomically. Ctrl-C writes nothing.
 """
 
 from __future__ import annotations
 
 import argparse
 import time
-from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,10 +31,13 @@ from tqdm import tqdm
 
 from dataset.core.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
 from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.provenance import make_provenance
-from segment.augment import IGNORE_LABEL, AugmentConfig
+from dataset.core.provenance import file_fingerprint, make_provenance
+from segment.augment import IGNORE_LABEL, REAL_PHOTO_AUGMENT, AugmentConfig
 from segment.evaluate import confusion_matrix, evenly_spaced, iou_per_class, mean_iou
 from segment.network import UNet, UNetConfig
+from segment.real_sets import SET_NAMES
+from segment.real_sets.splits import LIST_DIR
+from segment.real_training import RealSource, real_sources
 from segment.segmenter import predict_labels
 from segment.training_data import (
     TrainingScene,
@@ -54,6 +62,8 @@ class TrainConfig:
     training (0: none; the last step's weights are kept). ``validate_every``: steps
     between validations, on ``val_frames`` evenly spaced frames per validation scene.
     ``max_minutes``: a safety cap; a run it stops is marked ``cut_short``.
+    ``real_share``: the share of each batch drawn from real photos when real sets are
+    given; ``real_val_photos``: validation photos per real set.
     """
 
     steps: int = 6000
@@ -66,6 +76,8 @@ class TrainConfig:
     validate_every: int = 250
     val_frames: int = 8
     max_minutes: float = 45.0
+    real_share: float = 0.5
+    real_val_photos: int = 24
     network: UNetConfig = field(default_factory=lambda: UNetConfig(base_channels=8, levels=6))
     augment: AugmentConfig = field(default_factory=AugmentConfig)
 
@@ -74,6 +86,8 @@ class TrainConfig:
             raise ValueError("steps, batch, threads, validate_every and val_frames must be >= 1")
         if self.val_every < 0 or self.learning_rate <= 0 or self.max_minutes <= 0:
             raise ValueError("val_every must be >= 0, learning_rate and max_minutes > 0")
+        if not 0 <= self.real_share <= 1 or self.real_val_photos < 1:
+            raise ValueError("real_share must be in [0, 1] and real_val_photos >= 1")
 
 
 @dataclass
@@ -85,9 +99,10 @@ class _Best:
 
 
 def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = TrainConfig(),
-                    *, progress: bool = True) -> dict[str, Any]:
-    """Train on the scenes of ``folders``, write ``out`` (and ``out.json``); return the
-    training record.
+                    *, real: Mapping[str, Path] | None = None,
+                    progress: bool = True) -> dict[str, Any]:
+    """Train on the scenes of ``folders`` and the real sets ``real`` (set name -> folder,
+    :mod:`segment.real_sets`), write ``out`` (and ``out.json``); return the training record.
 
     Raises
     ------
@@ -104,24 +119,30 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
         train, val = split_by_building(scenes, config.val_every)
         if not train:
             raise ValueError("no building left to train on; lower --val-every or add scenes")
+        real_train, real_val = (real_sources(real, config.real_val_photos) if real
+                                else ([], []))
         # The record names the code as it was when training started.
+        inputs: dict[str, Any] = {"scenes": {f"{s.record['folder']}/{s.name}":
+                                             s.record["transforms"] for s in train + val}}
+        if real:
+            inputs["real_split_lists"] = {n: file_fingerprint(LIST_DIR / f"{n}.csv")
+                                          for n in real}
         provenance = make_provenance(
-            asdict(config), modules=("segment", "dataset"),
-            inputs={"scenes": {f"{s.record['folder']}/{s.name}": s.record["transforms"]
-                               for s in train + val}},
+            asdict(config), modules=("segment", "dataset"), inputs=inputs,
             libraries=("torch", "numpy", "opencv-contrib-python-headless"))
         rng = np.random.default_rng(config.seed)
         torch.manual_seed(config.seed)
-        weights = class_weights(train, rng)
+        weights = class_weights([*train, *real_train], rng)
         model = UNet(config.network).to(memory_format=torch.channels_last)
-        best, history, steps_run = _optimise(model, train, val, weights, config, rng, start,
-                                             progress)
+        best, history, steps_run = _optimise(model, (train, real_train), (val, real_val),
+                                             weights, config, rng, start, progress)
         if best.state is not None:
             model.load_state_dict(best.state)
         # Milliseconds: a few steps on a fast machine take well under 0.1 s.
         times = {"wall_time_s": round(time.perf_counter() - start, 3),
                  "cpu_time_s": round(time.process_time() - cpu_start, 3)}
-        record = _record(config, train, val, weights, best, history, steps_run, times)
+        record = _record(config, [*train, *real_train], [*val, *real_val], weights, best,
+                         history, steps_run, times)
         record["provenance"] = provenance.to_json_dict()
         save_weights(out, model, record)
         return record
@@ -129,10 +150,16 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
         torch.set_num_threads(previous_threads)
 
 
-def _optimise(model: UNet, train: list[TrainingScene], val: list[TrainingScene],
-              weights: np.ndarray, config: TrainConfig, rng: np.random.Generator,
-              start: float, progress: bool) -> tuple[_Best, list[dict[str, float]], int]:
-    """The training loop: (best validation step, history, steps run)."""
+def _optimise(model: UNet, train: tuple[list[TrainingScene], list[RealSource]],
+              val: tuple[list[TrainingScene], list[RealSource]], weights: np.ndarray,
+              config: TrainConfig, rng: np.random.Generator, start: float,
+              progress: bool) -> tuple[_Best, list[dict[str, float]], int]:
+    """The training loop: (best validation step, history, steps run). ``train`` and ``val``
+    are (render scenes, real-photo sources); the weights kept are picked on the real
+    validation photos when there are any, else on the validation buildings."""
+    renders, real = train
+    n_real = int(round(config.batch * config.real_share)) if real else 0
+    selection = val[1] if val[1] else val[0]
     optimiser = torch.optim.AdamW(model.parameters(), lr=config.learning_rate,
                                   weight_decay=config.weight_decay)
     schedule = torch.optim.lr_scheduler.OneCycleLR(optimiser, config.learning_rate,
@@ -144,7 +171,7 @@ def _optimise(model: UNet, train: list[TrainingScene], val: list[TrainingScene],
     step = 0
     for step in bar:
         model.train()
-        x, y = sample_batch(train, config.batch, config.augment, rng)
+        x, y = _mixed_batch(renders, real, config.batch - n_real, n_real, config, rng)
         loss = F.cross_entropy(model(x), y, weight=class_w, ignore_index=IGNORE_LABEL)
         optimiser.zero_grad(set_to_none=True)
         loss.backward()
@@ -156,8 +183,11 @@ def _optimise(model: UNet, train: list[TrainingScene], val: list[TrainingScene],
             entry = {"step": step, "loss": float(np.mean(losses)),
                      "minutes": (time.perf_counter() - start) / 60}
             losses = []
-            if val:
-                iou = _validate(model, val, config.val_frames, config.threads)
+            if val[0] and val[1]:
+                render_iou = _validate(model, val[0], config.val_frames, config.threads)
+                entry["val_renders_window_iou"] = float(render_iou[SemanticClass.WINDOW])
+            if selection:
+                iou = _validate(model, selection, config.val_frames, config.threads)
                 entry["val_window_iou"] = float(iou[SemanticClass.WINDOW])
                 entry["val_score"] = float(np.mean(iou[list(SELECTION_CLASSES)]))
                 if entry["val_score"] > best.score:
@@ -171,19 +201,33 @@ def _optimise(model: UNet, train: list[TrainingScene], val: list[TrainingScene],
             tqdm.write(f"stopped after {step} of {config.steps} steps: the "
                        f"{config.max_minutes:g}-minute cap was reached (recorded as cut short)")
             break
-    if not val:
+    if not selection:
         best = _Best(step)
     return best, history, step
 
 
-def _validate(model: UNet, val: list[TrainingScene], frames: int, threads: int) -> np.ndarray:
-    """(NUM_CLASSES,) IoU per class on the validation scenes, pooled per scene, then the
-    mean over scenes (NaN-aware)."""
+def _mixed_batch(renders: list[TrainingScene], real: list[RealSource], n_renders: int,
+                 n_real: int, config: TrainConfig, rng: np.random.Generator
+                 ) -> tuple[torch.Tensor, torch.Tensor]:
+    """``n_renders`` render crops then ``n_real`` real-photo crops, one batch."""
+    parts = [sample_batch(sources, n, config.augment, rng)
+             for sources, n in ((renders, n_renders), (real, n_real)) if n > 0]
+    x = torch.cat([p[0] for p in parts]).contiguous(memory_format=torch.channels_last)
+    return x, torch.cat([p[1] for p in parts])
+
+
+def _validate(model: UNet, val: Sequence[TrainingScene | RealSource], frames: int,
+              threads: int) -> np.ndarray:
+    """(NUM_CLASSES,) IoU per class on the validation scenes (or real sources), pooled per
+    scene, then the mean over scenes (NaN-aware). A render scene gives ``frames`` evenly
+    spaced frames; a real source all its photos."""
     model.eval()
     ious = []
     for scene in val:
         confusion = np.zeros((NUM_CLASSES, NUM_CLASSES), np.int64)
-        for frame in evenly_spaced(scene.frames, frames):
+        picked = scene.frames if isinstance(scene, RealSource) else evenly_spaced(
+            scene.frames, frames)
+        for frame in picked:
             rgb, exact = scene.rgb_and_labels(frame)
             confusion += confusion_matrix(predict_labels(model, rgb, threads=threads), exact)
         ious.append(iou_per_class(confusion))
@@ -195,7 +239,8 @@ def _or_none(value: float) -> float | None:
     return None if np.isnan(value) else float(value)
 
 
-def _record(config: TrainConfig, train: list[TrainingScene], val: list[TrainingScene],
+def _record(config: TrainConfig, train: Sequence[TrainingScene | RealSource],
+            val: Sequence[TrainingScene | RealSource],
             weights: np.ndarray, best: _Best, history: list[dict[str, float]],
             steps_run: int, times: dict[str, float]) -> dict[str, Any]:
     return {
@@ -251,6 +296,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--max-minutes", type=float, default=d.max_minutes,
                         help=f"time cap; a run it stops is recorded as cut short "
                         f"(default {d.max_minutes:g})")
+    for name in SET_NAMES:
+        parser.add_argument(f"--{name}", type=Path,
+                            help=f"a copy of the real set {name}: its train photos are trained "
+                            f"on, its val photos pick the weights (docs/segment.md)")
+    parser.add_argument("--real-share", type=float, default=d.real_share,
+                        help=f"share of each batch from real photos when real sets are given "
+                        f"(default {d.real_share})")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
@@ -259,12 +311,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.out.suffix != ".pt":
             raise ValueError(f"--out {args.out} must name a .pt file")
         check_output_folder(args.out.parent, "--out")
+        real = {n: getattr(args, n) for n in SET_NAMES if getattr(args, n) is not None}
+        augment = replace(REAL_PHOTO_AUGMENT if real else AugmentConfig(), crop_px=args.crop)
         config = TrainConfig(
             steps=args.steps, batch=args.batch, learning_rate=args.learning_rate,
             seed=args.seed, threads=args.threads, val_every=args.val_every,
             validate_every=args.validate_every, max_minutes=args.max_minutes,
-            augment=AugmentConfig(crop_px=args.crop))
-        record = train_segmenter(args.data, args.out, config, progress=not args.quiet)
+            real_share=args.real_share, augment=augment)
+        record = train_segmenter(args.data, args.out, config, real=real or None,
+                                 progress=not args.quiet)
         print(f"wrote {args.out} ({len(record['trained_on'])} training scenes, "
               f"{record['steps_run']} steps, {record['wall_time_s'] / 60:.1f} min); validation "
               f"window IoU {record['val_window_iou']}")

@@ -47,6 +47,10 @@ class TrainingScene:
         """(H, W, 3) uint8 RGB and (H, W) uint8 exact class ids of one frame."""
         return read_rgb(self.scene.path(frame.file_path)), read_frame_labels(self.scene, frame)
 
+    def labels(self, frame: Frame) -> np.ndarray:
+        """(H, W) uint8 exact class ids of one frame."""
+        return read_frame_labels(self.scene, frame)
+
 
 def load_training_scenes(folders: Sequence[Path]) -> list[TrainingScene]:
     """Every scene of ``folders`` (each a scene folder or a folder of them).
@@ -78,15 +82,17 @@ def split_by_building(scenes: Sequence[TrainingScene], val_every: int
             [s for s in scenes if s.name in val_names])
 
 
-def class_weights(scenes: Sequence[TrainingScene], rng: np.random.Generator,
+def class_weights(scenes: Sequence[Any], rng: np.random.Generator,
                   frames: int = 200) -> np.ndarray:
     """(NUM_CLASSES,) loss weights ``sqrt(median frequency / frequency)`` measured on
-    ``frames`` random training masks (clipped to [0.1, 10]; 1 for an absent class)."""
+    ``frames`` random training masks (clipped to [0.1, 10]; 1 for an absent class).
+    ``scenes``: training scenes or real-photo sources (anything with ``frames`` and
+    ``labels(frame)``; ids of :data:`IGNORE_LABEL` are not counted)."""
     pairs = [(s, f) for s in scenes for f in s.frames]
     counts = np.zeros(NUM_CLASSES)
     for i in rng.choice(len(pairs), size=min(frames, len(pairs)), replace=False):
         scene, frame = pairs[i]
-        labels = read_frame_labels(scene.scene, frame)
+        labels = scene.labels(frame)
         counts += np.bincount(labels.ravel(), minlength=NUM_CLASSES)[:NUM_CLASSES]
     present = counts > 0
     freq = counts / counts.sum()
@@ -95,9 +101,10 @@ def class_weights(scenes: Sequence[TrainingScene], rng: np.random.Generator,
     return np.clip(weights, 0.1, 10.0)
 
 
-def sample_batch(scenes: Sequence[TrainingScene], batch: int, config: AugmentConfig,
+def sample_batch(scenes: Sequence[Any], batch: int, config: AugmentConfig,
                  rng: np.random.Generator) -> tuple[torch.Tensor, torch.Tensor]:
-    """A batch of augmented crops from random frames of random scenes.
+    """A batch of augmented crops from random frames of random scenes (training scenes or
+    real-photo sources: anything with ``frames`` and ``rgb_and_labels(frame)``).
 
     Returns ``Float[Tensor, "B 3 S S"]`` RGB in [0, 1] (channels-last memory) and
     ``Long[Tensor, "B S S"]`` labels (:data:`IGNORE_LABEL` where there is none).
