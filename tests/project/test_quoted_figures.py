@@ -18,7 +18,7 @@ from paths import REPO_ROOT
 
 from metrics.publish import read_record, stale_code
 
-MARKER = re.compile(r"<!-- figures: (\S+)( \(earlier code[^)]*\))? -->")
+MARKER = re.compile(r"^<!-- figures: (\S+)( \(earlier code[^)]*\))? -->$")  # a line of its own
 DECIMAL = re.compile(r"(?<![\w.])-?\d+\.\d+(?![\w.])")
 DOCS = sorted([REPO_ROOT / "README.md", *(REPO_ROOT / "docs").rglob("*.md")])
 
@@ -28,7 +28,7 @@ def quoting_blocks(text: str) -> list[tuple[str, bool, str]]:
     lines = text.splitlines()
     out = []
     for i, line in enumerate(lines):
-        m = MARKER.search(line)
+        m = MARKER.match(line.strip())
         if not m:
             continue
         block = []
