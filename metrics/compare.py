@@ -49,6 +49,7 @@ from metrics.errors import (
     FacadeErrors,
     building_errors,
     facade_errors,
+    missed_facades,
 )
 from metrics.errors import failed_building as failed_row
 from metrics.executors import make_executor
@@ -196,6 +197,7 @@ def evaluate(
         family = truth.type if truth is not None else NO_TRUTH_FAMILY
         if o.result is None:
             rows.append(failed_row(o.scene, family, o.method, o.protocol, o.reason))
+            facade_rows.extend(missed_facades(o.scene, o.method, o.protocol, truth, o.reason))
             continue
         rows.append(building_errors(o.result, truth, stale=o.status == "stale"))
         facade_rows.extend(facade_errors(o.result, truth))

@@ -250,13 +250,17 @@ def visible_errors(result: MethodResult, truth: BuildingTruth | None) -> dict[st
 
 def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[FacadeErrors, ...]:
     """Per-facade rows of a result under the one scoring rule (:mod:`metrics.facade_scoring`):
-    one per truth facade (matched or missed) and one per false-positive estimate; none
-    where there is no truth or the result's facades cannot be paired (own ids without
-    locations). A malformed result file fails its facades, not the run.
+    one per truth facade (matched or missed) and one per false-positive estimate; every truth
+    facade missed for a failed run (no WWR, no facades); none where there is no truth or the
+    result's facades cannot be paired (own ids without locations). A malformed result file
+    fails its facades, not the run.
     """
     if truth is None:
         return ()
     base = (result.scene, truth.type, result.method, result.protocol)
+    if result.wwr is None and not result.facades:  # a failed run estimated no facade
+        return missed_facades(result.scene, result.method, result.protocol, truth,
+                              "; ".join(result.warnings) or "the method produced no WWR")
     try:
         match = pair_facades(result, truth)
     except ValueError as exc:
@@ -286,6 +290,17 @@ def facade_errors(result: MethodResult, truth: BuildingTruth | None) -> tuple[Fa
                              facade_est_m2=u.estimate.facade_area_m2)
                 for u in match.false_positives)
     return tuple(rows)
+
+
+def missed_facades(scene: str, method: str, protocol: str, truth: BuildingTruth | None,
+                   reason: str) -> tuple[FacadeErrors, ...]:
+    """Per-facade rows of a run that estimated no facade (it failed, or left no result
+    file): every truth facade missed, with ``reason``; none without a truth."""
+    if truth is None:
+        return ()
+    return tuple(FacadeErrors(scene, truth.type, method, protocol, f.id, status="failed",
+                              reason=reason, wwr_true=f.wwr, kind="missed")
+                 for f in truth.facades)
 
 
 def _ape_or_none(

@@ -11,8 +11,9 @@ Per family, method and views (and over all families), from the per-facade rows o
   (a missed facade counts as outside both: the street-view papers' figure);
 - **building WWR error**: Table 2's (%), beside them.
 
-A result that reports no per-facade figures, or numbers its own facades without locating
-them, has no rows and does not count here (the ``Buildings`` column says how many did).
+A failed run (no result, or no WWR) has missed every facade of its building. A result that
+reports no per-facade figures, or numbers its own facades without locating them, has no
+rows and does not count here (the ``Buildings`` column says how many did).
 A building trained with several seeds counts once per seed.
 """
 

@@ -114,8 +114,13 @@ def test_plots_footprints_and_pointers_are_written(compared):
 def test_per_facade_rows(compared):
     out, _ = compared
     rows = read_csv_rows((out / "per_facade.csv").read_text())
-    assert [(r["scene"], r["facade_id"]) for r in rows] == [("sky_a", "1"), ("sky_a", "2")]
-    assert [float(r["wwr_ape"]) for r in rows] == pytest.approx([20.0, 0.0], abs=TOL)
+    # ell_c's failed runs (a corrupt file, no file) missed both of its facades
+    missed = [(r["scene"], r["method"], r["facade_id"]) for r in rows if r["kind"] == "missed"]
+    assert missed == [("ell_c", m, f) for m in ("2D-SS", "neural3d") for f in ("1", "2")]
+    assert all(r["status"] == "failed" for r in rows if r["kind"] == "missed")
+    matched = [r for r in rows if r["kind"] == "matched"]
+    assert [(r["scene"], r["facade_id"]) for r in matched] == [("sky_a", "1"), ("sky_a", "2")]
+    assert [float(r["wwr_ape"]) for r in matched] == pytest.approx([20.0, 0.0], abs=TOL)
 
 
 @pytest.mark.parametrize(

@@ -14,7 +14,7 @@ from dataset.core.results import FacadeEstimate, MethodResult
 from dataset.core.wwr import ClassAreas
 from dataset.importers.citygml_import import import_citygml
 from dataset.presets import build_building, preset_recipes
-from metrics.errors import LEFT_OUT_FACADE_ID, building_errors, facade_errors
+from metrics.errors import LEFT_OUT_FACADE_ID, building_errors, facade_errors, missed_facades
 from metrics.facade_match import ON_WALL_MAX_DISTANCE_M
 from metrics.facade_scoring import score_result
 
@@ -160,3 +160,13 @@ def test_against_a_truth_that_counts_every_wall_the_figures_are_the_results_own(
     assert building_errors(result, truth).facade_est_m2 == 10.0
     rows = facade_errors(result, truth)
     assert [r.kind for r in rows] == ["missed"] * len(truth.facades) + ["false_positive"]
+
+
+def test_a_failed_run_missed_every_facade():
+    truth, perfect, _, _ = _closed_form_case()
+    failed = replace(_result("x", (perfect,)), wwr=None, window_area_m2=None,
+                     facade_area_m2=None, facades=(), warnings=("no usable view",))
+    rows = facade_errors(failed, truth)
+    assert [(r.facade_id, r.kind, r.reason) for r in rows] == [
+        (f.id, "missed", "no usable view") for f in truth.facades]
+    assert missed_facades("x", "m", "street", None, "gone") == ()
