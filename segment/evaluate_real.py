@@ -38,10 +38,11 @@ from segment.real_measure import (
     wwr_scores,
 )
 from segment.real_sets import SET_NAMES, RealPhoto, cmp, labelmefacade, read_set
-from segment.real_sets.splits import SPLITS, committed_splits, split_of
+from segment.real_sets.common import PHOTO_SPLITS, PHOTO_TEST, PHOTO_TRAIN, PHOTO_VAL
+from segment.real_sets.splits import committed_splits, split_of
 from segment.segmenter import Segmenter, resolve_segmenter
 
-REPORT_SPLITS = ("test", "val", "train")
+REPORT_SPLITS = (PHOTO_TEST, PHOTO_VAL, PHOTO_TRAIN)
 """Order of the splits in the report."""
 _SOURCES = {labelmefacade.SET_NAME: labelmefacade.SOURCE, cmp.SET_NAME: cmp.SOURCE}
 
@@ -54,7 +55,7 @@ def evaluate_set(photos: Sequence[RealPhoto], segmenter: Segmenter,
     by_split: dict[str, list[RealPhoto]] = {s: [] for s in REPORT_SPLITS}
     for photo in photos:
         split = split_of(photo, committed)
-        if split in SPLITS:
+        if split in PHOTO_SPLITS:
             by_split[split].append(photo)
     out = {}
     for split in REPORT_SPLITS:
@@ -114,7 +115,7 @@ def report_markdown(results: dict[str, dict[str, list[PhotoResult]]], segmenter:
                   f"| split | answer | facades | labels' WWR, mean | answer's WWR, mean | "
                   f"mean absolute error (points) | mean error (points) | {bands} |",
                   "|---|---|---|---|---|---|---|" + "---|" * len(WWR_BANDS_POINTS)]
-        constant = mean_labels_wwr(results[cmp.SET_NAME].get("train") or [])
+        constant = mean_labels_wwr(results[cmp.SET_NAME].get(PHOTO_TRAIN) or [])
         for split, rows in results[cmp.SET_NAME].items():
             if not rows:
                 continue

@@ -21,6 +21,7 @@ import numpy as np
 
 from segment.evaluate import evenly_spaced
 from segment.real_sets import RealPhoto, read_photo_pair, read_set
+from segment.real_sets.common import PHOTO_TRAIN, PHOTO_VAL
 from segment.real_sets.splits import committed_splits, split_of
 
 
@@ -61,22 +62,22 @@ def real_sources(roots: Mapping[str, Path], val_photos: int = 24
     for set_name, root in roots.items():
         photos = read_set(set_name, root)
         committed = committed_splits(set_name)
-        by_split: dict[str, list[RealPhoto]] = {"train": [], "val": []}
+        by_split: dict[str, list[RealPhoto]] = {PHOTO_TRAIN: [], PHOTO_VAL: []}
         for photo in photos:
             split = split_of(photo, committed)
             if split in by_split:
                 by_split[split].append(photo)
-        if not by_split["train"]:
+        if not by_split[PHOTO_TRAIN]:
             raise ValueError(f"{root}: no photo of {set_name} is in its train split "
                              f"(segment/real_sets/splits/{set_name}.csv)")
-        picks = {"train": tuple(by_split["train"]),
-                 "val": evenly_spaced(sorted(by_split["val"], key=lambda p: p.name),
+        picks = {PHOTO_TRAIN: tuple(by_split[PHOTO_TRAIN]),
+                 PHOTO_VAL: evenly_spaced(sorted(by_split[PHOTO_VAL], key=lambda p: p.name),
                                       val_photos)}
         for split, chosen in picks.items():
             if not chosen:
                 continue
             record = {"set": set_name, "split": split, "folder": str(root),
                       "photos": len(chosen), "names": [p.name for p in chosen]}
-            (train if split == "train" else val).append(
+            (train if split == PHOTO_TRAIN else val).append(
                 RealSource(set_name, split, chosen, record))
     return train, val

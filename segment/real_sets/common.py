@@ -18,6 +18,10 @@ import numpy as np
 
 from segment.photo_io import read_photo_rgb
 
+PHOTO_TRAIN, PHOTO_VAL, PHOTO_TEST = "train", "val", "test"
+PHOTO_SPLITS = (PHOTO_TRAIN, PHOTO_VAL, PHOTO_TEST)
+"""The splits of the real photo sets (:mod:`segment.real_sets.splits`), spelled once; not
+the scene frames' splits (:mod:`dataset.core.protocols`)."""
 IGNORED = 255
 """Label of a pixel that is not counted (unlabelled, or a class that fits no project class)."""
 

@@ -39,8 +39,8 @@ SOURCE = {
     "commit": "a0dbc272351f9d6914805fbba62d75740308f52f",
     "licence": "non-commercial research use only (README); not committed here",
 }
-LISTS = ("train", "test")
-"""LabelMeFacade's own image lists (``<list>.txt``)."""
+LISTS = ("train.txt", "test.txt")
+"""LabelMeFacade's own image lists."""
 COLOURS: dict[tuple[int, int, int], int] = {
     (0, 0, 0): IGNORED,  # various
     (128, 0, 0): SemanticClass.WALL,  # building
@@ -75,10 +75,11 @@ def labelmefacade_photos(root: str | Path) -> list[RealPhoto]:
     """
     root = Path(root)
     photos = []
-    for part in LISTS:
-        listing = root / f"{part}.txt"
+    for list_name in LISTS:
+        listing = root / list_name
+        part = Path(list_name).stem
         if not listing.is_file():
-            raise ValueError(f"{root} is not a LabelMeFacade folder (no {part}.txt); clone "
+            raise ValueError(f"{root} is not a LabelMeFacade folder (no {list_name}); clone "
                              f"{SOURCE['repository']} and give its folder")
         for line in listing.read_text(encoding="utf-8-sig").splitlines():
             if not line.strip():

@@ -33,9 +33,9 @@ from pathlib import Path
 from dataset.core.atomic import write_text_atomic
 from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
 from segment.real_sets import SET_NAMES, RealPhoto, read_set
+from segment.real_sets.common import PHOTO_SPLITS, PHOTO_TEST, PHOTO_TRAIN, PHOTO_VAL
 
 SALT = "envelope-bench real-photo splits 2026-11-28"
-SPLITS = ("train", "val", "test")
 NONE = "none"
 """Split of a photo used by nothing (LabelMeFacade ``train.txt`` photo of a test group)."""
 TEST_BELOW = {"labelmefacade": 0.35, "cmp": 0.25}
@@ -58,8 +58,8 @@ def split_rule(photo: RealPhoto) -> str:
     if position < TEST_BELOW[photo.set_name]:
         if photo.set_name == "labelmefacade" and photo.part != "test":
             return NONE
-        return "test"
-    return "val" if position < VAL_BELOW[photo.set_name] else "train"
+        return PHOTO_TEST
+    return PHOTO_VAL if position < VAL_BELOW[photo.set_name] else PHOTO_TRAIN
 
 
 def committed_splits(set_name: str, list_dir: Path = LIST_DIR) -> dict[str, str]:
@@ -77,7 +77,7 @@ def committed_splits(set_name: str, list_dir: Path = LIST_DIR) -> dict[str, str]
     rows = list(csv.DictReader(io.StringIO(path.read_text())))
     if not rows or tuple(rows[0]) != _COLUMNS:
         raise ValueError(f"{path}: expected columns {','.join(_COLUMNS)}")
-    bad = [r["name"] for r in rows if r["split"] not in (*SPLITS, NONE)]
+    bad = [r["name"] for r in rows if r["split"] not in (*PHOTO_SPLITS, NONE)]
     if bad:
         raise ValueError(f"{path}: unknown split for {bad[:3]}")
     return {r["name"]: r["split"] for r in rows}
@@ -124,7 +124,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             counts = Counter(split_rule(p) for p in photos)
             groups = {s: len({p.group for p in photos if split_rule(p) == s}) for s in counts}
             print(f"{name}: " + ", ".join(f"{s} {counts[s]} photos ({groups[s]} groups)"
-                                          for s in (*SPLITS, NONE) if s in counts))
+                                          for s in (*PHOTO_SPLITS, NONE) if s in counts))
         return 0
 
     return run_cli("segment.real_sets.splits", body, debug=args.debug)

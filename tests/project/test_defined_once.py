@@ -115,7 +115,9 @@ def test_protocol_and_split_names_are_spelled_only_in_dataset_protocols():
         name = str(path.relative_to(ROOT))
         spelled += [f"{name}:{line} {value!r}" for line, value in code_strings(path)
                     if value in ("ideal", "multi", "train", "eval")]
-    assert spelled and all(s.startswith("dataset/core/protocols.py:") for s in spelled), spelled
+    # the real photo sets' own train/val/test (segment.real_sets.common) are not scene splits
+    allowed = ("dataset/core/protocols.py:", "segment/real_sets/common.py:")
+    assert spelled and all(s.startswith(allowed) for s in spelled), spelled
 
 
 @pytest.mark.slow

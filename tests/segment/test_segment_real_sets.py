@@ -24,9 +24,10 @@ from segment.evaluate_real import evaluate_set, main
 from segment.real_measure import facade_wwr, photo_result, split_scores, wwr_scores
 from segment.real_sets import IGNORED, read_photo_pair, read_set
 from segment.real_sets.cmp import CMP_CLASSES, cmp_labels
+from segment.real_sets.common import PHOTO_SPLITS as SPLITS
 from segment.real_sets.common import RealPhoto
 from segment.real_sets.labelmefacade import labels_from_colours, photo_group
-from segment.real_sets.splits import LIST_DIR, NONE, SPLITS, committed_splits, split_of, split_rule
+from segment.real_sets.splits import LIST_DIR, NONE, committed_splits, split_of, split_rule
 from segment.segmenter import Segmenter
 
 
