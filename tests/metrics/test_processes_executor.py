@@ -58,6 +58,7 @@ def _without_times(outcomes):
             for o in outcomes]
 
 
+@pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
     light = method_specs(("2D-SS",), ("ideal",), tmp_path)[0]
@@ -71,6 +72,7 @@ def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path
         p.name for p in (tmp_path / "local").iterdir())
 
 
+@pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
     for cores, expect_here in ((1.0, False), (2.0, True)):
@@ -86,6 +88,7 @@ def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path
         assert ran_here == {expect_here}, f"{cores} cores a run"
 
 
+@pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
     spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,

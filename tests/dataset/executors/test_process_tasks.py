@@ -45,6 +45,7 @@ def _stopped(folder: str) -> None:
         Path(folder, "cleaned-up").touch()
 
 
+@pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_values_come_back_by_index_and_the_cpus_bound_how_many_run_at_once(tmp_path):
     calls = [((str(tmp_path), i, 1.5), TaskResources(cpus=1.0)) for i in range(5)]
     got = dict(run_in_processes(_marked, calls, Capacity(cpus=2)))
