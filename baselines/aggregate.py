@@ -13,7 +13,7 @@ from typing import Any, Literal
 import numpy as np
 
 from baselines.weighting import Weighting, facade_weights, weighted_building_wwr
-from dataset.core.results import FacadeEstimate, MethodResult, code_version
+from envelope.results import FacadeEstimate, MethodResult, code_version
 
 Combine = Literal["mean", "median"]
 COMBINES: tuple[str, ...] = ("mean", "median")

@@ -19,7 +19,7 @@ import numpy as np
 
 from baselines.plane import Plane, intersect_rays_plane
 from baselines.views import ViewError
-from dataset.core.camera import Intrinsics, project_world_to_image
+from envelope.camera import Intrinsics, project_world_to_image
 
 
 def corners_camera_m(corners_uv: np.ndarray, plane: Plane, intrinsics: Intrinsics) -> np.ndarray:

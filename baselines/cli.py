@@ -20,12 +20,12 @@ from pathlib import Path
 from tqdm import tqdm
 
 from dataset.benchmark_cache import DefaultBenchmark, default_results_folder, ensure_benchmark
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
-from dataset.core.method_input import MethodInput
-from dataset.core.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
-from dataset.core.results import MethodResult, write_result
-from dataset.core.warnings_summary import summarise_warnings
-from dataset.scenes.scene import read_method_input
+from envelope.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
+from envelope.method_input import MethodInput
+from envelope.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
+from envelope.results import MethodResult, write_result
+from envelope.scenes.scene import read_method_input
+from envelope.warnings_summary import summarise_warnings
 
 
 def scene_folders(data: Path) -> list[Path]:
@@ -145,5 +145,5 @@ def run_scenes(data: Path | None, out: Path | None,
 
 def main_guarded(prog: str, body: Callable[[], int], debug: bool = False) -> int:
     """Run a CLI body: a user's mistake becomes one line on stderr and exit 2
-    (:func:`dataset.core.cli_errors.run_cli`)."""
+    (:func:`envelope.cli_errors.run_cli`)."""
     return run_cli(prog, body, debug=debug)

@@ -14,12 +14,12 @@ import cv2
 import numpy as np
 
 from baselines.rectify import OUTSIDE
-from dataset.core.classes import CLASS_RGB
-from dataset.scenes.images import write_rgb
+from envelope.classes import CLASS_RGB
+from envelope.scenes.images import write_rgb
 
 Kind = Literal["mask", "corners", "rectified"]
 
-# RGB colours of the class ids (dataset.core.classes.CLASS_RGB) and of OUTSIDE.
+# RGB colours of the class ids (envelope.classes.CLASS_RGB) and of OUTSIDE.
 _PALETTE = np.zeros((256, 3), dtype=np.uint8)
 _PALETTE[:len(CLASS_RGB)] = CLASS_RGB
 _PALETTE[OUTSIDE] = (255, 255, 255)

@@ -33,9 +33,9 @@ import numpy as np
 from baselines.plane_merge import FacadePlane
 from baselines.posed_views import PosedView
 from baselines.view_planes import UP
-from dataset.core.camera import project_world_to_image
-from dataset.core.classes import SemanticClass
-from dataset.core.wwr import ClassAreas
+from envelope.camera import project_world_to_image
+from envelope.classes import SemanticClass
+from envelope.wwr import ClassAreas
 
 NONE, WALL, WINDOW, DOOR = range(4)  # vote indices
 _VOTE_OF_CLASS = np.zeros(256, dtype=np.int64)

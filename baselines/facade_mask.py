@@ -27,8 +27,8 @@ import numpy as np
 
 from baselines.plane import Plane, fit_plane_ransac, points_camera_m
 from baselines.views import ViewError
-from dataset.core.camera import Intrinsics
-from dataset.core.classes import FACADE_CLASSES, SemanticClass
+from envelope.camera import Intrinsics
+from envelope.classes import FACADE_CLASSES, SemanticClass
 
 _MIN_FIT_PIXELS = 200  # fewer sampled pixels than this: fit to every pixel instead
 _FACADE_LOOKUP = np.isin(np.arange(256), [int(c) for c in FACADE_CLASSES])  # uint8 id -> bool

@@ -1,4 +1,4 @@
-"""2D-S and 2D-SS as benchmark methods (:class:`dataset.core.method.Method`)."""
+"""2D-S and 2D-SS as benchmark methods (:class:`envelope.method.Method`)."""
 
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ from pathlib import Path
 
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
-from dataset.core.method import Method
-from dataset.core.method_input import MethodInput
-from dataset.core.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
+from envelope.method import Method
+from envelope.method_input import MethodInput
+from envelope.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
 
 PROTOCOLS_2D = (*VIEW_PROTOCOLS, STREET_PROTOCOL)  # the street capture: their own facades
 LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")

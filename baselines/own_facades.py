@@ -8,13 +8,13 @@ photo may show several. Both methods then:
 2. merge the planes of all views into facades (:mod:`baselines.plane_merge`): the
    method's own facades, ids 1..K in order of their outward normal's azimuth
    (counter-clockwise from +x), each with its ``normal`` and ``centre_m`` so that
-   evaluation pairs them with the truth's walls (:mod:`metrics.facade_match`).
+   evaluation pairs them with the truth's walls (:mod:`metrics.score.facade_match`).
 
 **2D-SS** measures each facade on its plane by cell voting (:mod:`baselines.facade_cells`):
 window, wall and door areas without counting what several views see twice; ``centre_m``
 is the centre of its measured cells. A facade under ``min_facade_area_m2`` is dropped (a
 chimney, a parapet, a sliver of a wall seen edge-on). The building's areas are the sums
-over its facades and its WWR their ratio (:class:`dataset.core.wwr.ClassAreas`).
+over its facades and its WWR their ratio (:class:`envelope.wwr.ClassAreas`).
 
 **2D-S** groups views by their dominant plane (the one with most pixels): views whose
 dominant planes merged into one facade form its group. Per view, the paper's pixel ratio on
@@ -38,11 +38,11 @@ from baselines.facade_cells import CellAreas, CellConfig, measure_facades
 from baselines.plane_merge import FacadePlane, MergeConfig, merge_view_planes
 from baselines.posed_views import PosedView, PosedViews, load_posed_views
 from baselines.view_planes import PlaneFitConfig, ViewPlane, find_view_planes
-from dataset.core.classes import SemanticClass
-from dataset.core.method_input import MethodInput
-from dataset.core.results import FacadeEstimate, MethodResult, code_version
-from dataset.core.scene_record import scene_name
-from dataset.core.wwr import ClassAreas, wwr_from_areas
+from envelope.classes import SemanticClass
+from envelope.method_input import MethodInput
+from envelope.results import FacadeEstimate, MethodResult, code_version
+from envelope.scene_record import scene_name
+from envelope.wwr import ClassAreas, wwr_from_areas
 
 
 @dataclass(frozen=True)

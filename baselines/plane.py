@@ -2,7 +2,7 @@
 
 Everything here lives in the OpenGL camera frame (camera at the origin, looking
 along -z, +y up), in metres. A pixel's ray is ``t * dir`` with ``dir`` from
-:func:`dataset.core.camera.camera_dirs_from_pixels` (z = -1), so ``t`` is z-depth.
+:func:`envelope.camera.camera_dirs_from_pixels` (z = -1), so ``t`` is z-depth.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, camera_dirs_from_pixels
+from envelope.camera import Intrinsics, camera_dirs_from_pixels
 
 
 @dataclass(frozen=True)

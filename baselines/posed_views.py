@@ -13,12 +13,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, pixel_centres, unproject_depth_to_world
-from dataset.core.classes import SemanticClass
-from dataset.core.method_input import MethodInput, require_method_input
-from dataset.core.protocols import OWN_FACADE_PROTOCOLS
-from dataset.core.scene_record import Frame, scene_name
-from dataset.scenes.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
+from envelope.camera import Intrinsics, pixel_centres, unproject_depth_to_world
+from envelope.classes import SemanticClass
+from envelope.method_input import MethodInput, require_method_input
+from envelope.protocols import OWN_FACADE_PROTOCOLS
+from envelope.scene_record import Frame, scene_name
+from envelope.scenes.scene_validation import (
+    InvalidSceneError,
+    read_frame_depth_m,
+    read_frame_labels,
+)
 
 FACADE_CLASSES = (SemanticClass.WALL, SemanticClass.WINDOW, SemanticClass.DOOR)
 
@@ -71,7 +75,7 @@ class PosedViews:
 
 def finds_own_facades(scene: MethodInput, split: str) -> bool:
     """Whether the 2D methods find the facades themselves on ``split``: a protocol declared
-    so (:data:`dataset.core.protocols.OWN_FACADE_PROTOCOLS`) or a split none of whose frames
+    so (:data:`envelope.protocols.OWN_FACADE_PROTOCOLS`) or a split none of whose frames
     names the facade it was taken of."""
     return split in OWN_FACADE_PROTOCOLS or all(f.facade_id is None
                                                 for f in scene.frames_in(split))

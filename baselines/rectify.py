@@ -7,7 +7,7 @@ Views are warped with kornia (nearest neighbour) in batches onto a canvas as
 large as the batch's largest rectangle; canvas pixels outside a view's
 rectangle are marked :data:`OUTSIDE`.
 
-Coordinates: ours are continuous with pixel centres at +0.5 (dataset.core.camera);
+Coordinates: ours are continuous with pixel centres at +0.5 (envelope.camera);
 kornia puts pixel centres at integers (``align_corners=True``), hence the 0.5 shifts.
 """
 
@@ -17,8 +17,8 @@ import numpy as np
 import torch
 from kornia.geometry.transform import get_perspective_transform, warp_perspective
 
-from dataset.core.classes import SemanticClass
-from dataset.core.wwr import wwr_from_areas
+from envelope.classes import SemanticClass
+from envelope.wwr import wwr_from_areas
 
 OUTSIDE = 255  # label of rectified-canvas pixels outside the facade rectangle
 

@@ -13,13 +13,17 @@ from typing import Literal
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics
-from dataset.core.method_input import MethodInput, require_method_input
-from dataset.core.protocols import VIEW_PROTOCOLS, ViewProtocol
-from dataset.core.scene_record import Frame, scene_name
-from dataset.scenes.scene_validation import InvalidSceneError, read_frame_depth_m, read_frame_labels
+from envelope.camera import Intrinsics
+from envelope.method_input import MethodInput, require_method_input
+from envelope.protocols import VIEW_PROTOCOLS, ViewProtocol
+from envelope.scene_record import Frame, scene_name
+from envelope.scenes.scene_validation import (
+    InvalidSceneError,
+    read_frame_depth_m,
+    read_frame_labels,
+)
 
-Protocol = ViewProtocol  # the 2D methods' protocols (dataset.core.protocols)
+Protocol = ViewProtocol  # the 2D methods' protocols (envelope.protocols)
 
 
 class ViewError(ValueError):

@@ -29,12 +29,12 @@ from baselines.facade_mask import facade_class_mask, isolate_facade_2ds
 from baselines.own_facades import OwnFacadesConfig, run_2ds_own
 from baselines.posed_views import finds_own_facades
 from baselines.views import FacadeView, Protocol, ViewError, load_views
-from dataset.core.classes import SemanticClass
-from dataset.core.cli_errors import check_output_folder
-from dataset.core.method_input import MethodInput
-from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.scene_record import scene_name
-from dataset.core.wwr import wwr_from_areas
+from envelope.classes import SemanticClass
+from envelope.cli_errors import check_output_folder
+from envelope.method_input import MethodInput
+from envelope.results import FacadeEstimate, MethodResult
+from envelope.scene_record import scene_name
+from envelope.wwr import wwr_from_areas
 
 METHOD = "2D-S"
 

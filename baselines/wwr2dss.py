@@ -63,13 +63,13 @@ from baselines.rectify import (
     rectify_labels,
 )
 from baselines.views import FacadeView, Protocol, ViewError, load_views
-from dataset.core.camera import Intrinsics
-from dataset.core.cli_errors import check_output_folder
-from dataset.core.device import resolve_device
-from dataset.core.method_input import MethodInput
-from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.scene_record import scene_name
-from dataset.scenes.images import read_rgb
+from envelope.camera import Intrinsics
+from envelope.cli_errors import check_output_folder
+from envelope.device import resolve_device
+from envelope.method_input import MethodInput
+from envelope.results import FacadeEstimate, MethodResult
+from envelope.scene_record import scene_name
+from envelope.scenes.images import read_rgb
 
 METHOD = "2D-SS"
 

@@ -15,7 +15,7 @@ generated instead).
 
 Accuracy: both methods on both protocols on every scene of ``--data``; the
 absolute percentage errors of WWR, window area and facade area against
-``building.json``, mean ± std per building family (metrics.errors / aggregate).
+``building.json``, mean ± std per building family (metrics.score.errors / aggregate).
 """
 
 from __future__ import annotations
@@ -44,14 +44,14 @@ from baselines.wwr2dss import (  # noqa: E402
     rectify_views,
     run_2dss,
 )
-from dataset.core.atomic import write_text_atomic  # noqa: E402
-from dataset.core.method_input import MethodInput  # noqa: E402
-from dataset.core.protocols import VIEW_PROTOCOLS  # noqa: E402
-from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
-from metrics.aggregate import aggregate_by_family  # noqa: E402
-from metrics.errors import building_errors, failed_building  # noqa: E402
-from metrics.report import table2_errors  # noqa: E402
-from metrics.tables import to_markdown  # noqa: E402
+from envelope.atomic import write_text_atomic  # noqa: E402
+from envelope.method_input import MethodInput  # noqa: E402
+from envelope.protocols import VIEW_PROTOCOLS  # noqa: E402
+from envelope.scenes.scene import read_method_input, read_scene  # noqa: E402
+from metrics.report.report import table2_errors  # noqa: E402
+from metrics.report.tables import to_markdown  # noqa: E402
+from metrics.score.aggregate import aggregate_by_family  # noqa: E402
+from metrics.score.errors import building_errors, failed_building  # noqa: E402
 
 SPEED_SIZE = 512
 PROTOCOLS = VIEW_PROTOCOLS

@@ -29,15 +29,15 @@ from tqdm import tqdm  # noqa: E402
 
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
-from dataset.core.mesh import read_labelled_ply  # noqa: E402
-from dataset.core.method_input import MethodInput  # noqa: E402
-from dataset.core.protocols import VIEW_PROTOCOLS  # noqa: E402
-from dataset.core.scene_record import Frame, Scene  # noqa: E402
 from dataset.rendering.render import Raycaster, render_ground_truth  # noqa: E402
-from dataset.scenes.images import write_depth_m, write_labels  # noqa: E402
-from dataset.scenes.scene import read_method_input, read_scene, write_transforms  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import building_errors  # noqa: E402
+from envelope.mesh import read_labelled_ply  # noqa: E402
+from envelope.method_input import MethodInput  # noqa: E402
+from envelope.protocols import VIEW_PROTOCOLS  # noqa: E402
+from envelope.scene_record import Frame, Scene  # noqa: E402
+from envelope.scenes.images import write_depth_m, write_labels  # noqa: E402
+from envelope.scenes.scene import read_method_input, read_scene, write_transforms  # noqa: E402
+from metrics.score.errors import building_errors  # noqa: E402
 
 
 def rerendered_scene(scene: Scene, raycaster: Raycaster, protocol: str, factor: int,

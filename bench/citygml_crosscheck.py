@@ -3,8 +3,8 @@
     python bench/citygml_crosscheck.py FILE_OR_DIR [...] [--pixel-m 0.02] [--out FILE]
 
 For every building of the CityGML files given (``.xml``/``.gml``/``.gml.gz``/``.xml.gz``),
-import it (:func:`dataset.importers.citygml_import.import_citygml`) and render each covered
-facade head-on (:func:`dataset.importers.citygml_crosscheck.check_facades`): the window and
+import it (:func:`dataset.importers.citygml.convert.import_citygml`) and render each covered
+facade head-on (:func:`dataset.importers.citygml.crosscheck.check_facades`): the window and
 gross areas back-projected from the facade-only render ("bare") and from the whole mesh
 ("seen": installations, roofs and other walls in front hide part of it) against the
 truth. Lists every building whose bare window or gross area differs by more than 2 %, and
@@ -20,9 +20,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from dataset.importers.citygml_crosscheck import PIXEL_M, check_facades  # noqa: E402
-from dataset.importers.citygml_files import citygml_files  # noqa: E402
-from dataset.importers.citygml_import import import_citygml  # noqa: E402
+from dataset.importers.citygml.convert import import_citygml  # noqa: E402
+from dataset.importers.citygml.crosscheck import PIXEL_M, check_facades  # noqa: E402
+from dataset.importers.citygml.files import citygml_files  # noqa: E402
 
 AGREE = 0.02
 

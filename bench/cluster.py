@@ -41,14 +41,14 @@ from pathlib import Path
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 from dataset.benchmark_cache import DefaultBenchmark  # noqa: E402
-from dataset.core.atomic import write_text_atomic  # noqa: E402
-from dataset.core.results import MethodResult  # noqa: E402
-from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
 from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
+from envelope.atomic import write_text_atomic  # noqa: E402
+from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
+from envelope.results import MethodResult  # noqa: E402
 from metrics.compare import compare  # noqa: E402
-from metrics.executors import make_executor  # noqa: E402
-from metrics.methods import method_specs  # noqa: E402
-from metrics.runner import Job, MethodSpec, find_scenes, run_job, run_missing  # noqa: E402
+from metrics.run.executors import make_executor  # noqa: E402
+from metrics.run.methods import method_specs  # noqa: E402
+from metrics.run.runner import Job, MethodSpec, find_scenes, run_job, run_missing  # noqa: E402
 from neural3d.method import Neural3dBudget  # noqa: E402
 
 NODES = (1, 2, 4, 8, 16, 32, 64)

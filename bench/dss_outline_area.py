@@ -5,7 +5,7 @@
 Runs 2D-SS on every scene of ``--data`` twice: with ``min_rectangle_fill=0`` (facade
 area always L x H, as before) and with the default (the mask outline's area where it
 fills less of the rectangle). Prints per building and protocol the absolute percentage
-errors of facade area, window area and WWR (metrics.errors), then their means.
+errors of facade area, window area and WWR (metrics.score.errors), then their means.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ import numpy as np  # noqa: E402
 
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
-from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import building_errors  # noqa: E402
+from envelope.scenes.scene import read_method_input, read_scene  # noqa: E402
+from metrics.score.errors import building_errors  # noqa: E402
 
 
 def main() -> None:

@@ -1,9 +1,9 @@
-"""Time ``metrics.export`` (every format) on a comparison's results; prints Markdown.
+"""Time ``metrics.export.command`` (every format) on a comparison's results; prints Markdown.
 
     python bench/export.py                       # the built-in default run's results
     python bench/export.py --results R --data D  # any comparison
 
-Reads the results and truths once, then times :func:`metrics.export.export` with
+Reads the results and truths once, then times :func:`metrics.export.command.export` with
 every format ``--repeat`` times into a temporary folder (best and median wall
 time, and the CPU time of this process), then each format alone once. The
 issue's bound is 10 s for every format on the built-in default run.
@@ -21,7 +21,7 @@ from pathlib import Path
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 from dataset.benchmark_cache import DefaultBenchmark  # noqa: E402
-from metrics.export import FORMATS, export, read_inputs  # noqa: E402
+from metrics.export.command import FORMATS, export, read_inputs  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:

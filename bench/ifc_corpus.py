@@ -3,16 +3,16 @@
     python bench/ifc_corpus.py CORPUS_DIR [--spacing-m 0.1] [--json out.json]
 
 Per file (``*.ifc``, or ``*.ifc.xz`` decompressed to a temporary file): the authoring tool and
-schema from the header, the import time (:func:`dataset.importers.ifc_import.read_ifc` and
-:func:`~dataset.importers.ifc_import.building_from_ifc`), the elements per class, the derived
+schema from the header, the import time (:func:`dataset.importers.ifc.convert.read_ifc` and
+:func:`~dataset.importers.ifc.convert.building_from_ifc`), the elements per class, the derived
 window / wall / door areas, WWR and footprint -- or the error -- and three independent
 measures:
 
 - **declared windows**: the sum of ``OverallWidth x OverallHeight`` of the IfcWindows beside
   the measured area of the same windows (their window faces on a facade);
-- **elevations** (:func:`dataset.importers.ifc_checks.elevation_areas`): the facade, window
+- **elevations** (:func:`dataset.importers.ifc.checks.elevation_areas`): the facade, window
   and WWR an architect would measure on orthographic elevation drawings;
-- **plan** (:func:`dataset.importers.ifc_checks.plan_footprint`): the union of the plan
+- **plan** (:func:`dataset.importers.ifc.checks.plan_footprint`): the union of the plan
   projections of the elements that stand at the footprint height, beside the imported
   footprint (area and IoU).
 
@@ -32,12 +32,12 @@ from pathlib import Path
 
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
-from dataset.importers.ifc_checks import (  # noqa: E402
+from dataset.importers.ifc.checks import (  # noqa: E402
     elevation_areas,
     footprint_iou,
     plan_footprint,
 )
-from dataset.importers.ifc_import import building_from_ifc, read_ifc  # noqa: E402
+from dataset.importers.ifc.convert import building_from_ifc, read_ifc  # noqa: E402
 from dataset.importers.import_config import ImportConfig  # noqa: E402
 
 

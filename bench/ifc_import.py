@@ -4,7 +4,7 @@
 
 Builds a 40 x 16 m tower, 3 m storeys: per storey four 0.3 m outer walls, two interior
 walls, a floor slab and 2 x 10 + 2 x 4 windows 1.5 x 1.5 m (each an opening and a window
-element), a roof slab on top; then times :func:`dataset.importers.ifc_import.import_ifc` and prints
+element), a roof slab on top; then times :func:`dataset.importers.ifc.convert.import_ifc` and prints
 the element and face counts with the truth's areas against their closed form.
 """
 
@@ -18,7 +18,7 @@ from pathlib import Path
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 from dataset.examples.ifc_houses import IfcHouse  # noqa: E402
-from dataset.importers.ifc_import import import_ifc  # noqa: E402
+from dataset.importers.ifc.convert import import_ifc  # noqa: E402
 
 LX, LY, H, T = 40.0, 16.0, 3.0, 0.3
 

@@ -3,9 +3,9 @@
     python bench/ifc_mesh_agreement.py [FOLDER] [--formats ply,obj] [--json rows.json]
 
 Per ``*.ifc`` / ``*.ifc.xz`` file of FOLDER (default: the committed fixtures,
-``tests/fixtures/ifc_real``): the IFC import (:func:`dataset.importers.ifc_import.read_ifc`,
-:func:`~dataset.importers.ifc_import.building_from_ifc`), then the same triangulation written
-as a labelled mesh, one body per element (:mod:`dataset.importers.ifc_mesh_export`), and
+``tests/fixtures/ifc_real``): the IFC import (:func:`dataset.importers.ifc.convert.read_ifc`,
+:func:`~dataset.importers.ifc.convert.building_from_ifc`), then the same triangulation written
+as a labelled mesh, one body per element (:mod:`dataset.importers.ifc.mesh_export`), and
 imported back with the mesh importer at the IFC's ground (``--ground-z``, as a user gives a
 mesh without storeys). Prints, per path, the window and facade areas, the WWR, the bodies
 found (closed / all) and the relative difference from the IFC import. Markdown
@@ -23,10 +23,10 @@ from pathlib import Path
 
 sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
-from dataset.importers.ifc_import import building_from_ifc, read_ifc  # noqa: E402
-from dataset.importers.ifc_mesh_export import write_model_mesh  # noqa: E402
+from dataset.importers.ifc.convert import building_from_ifc, read_ifc  # noqa: E402
+from dataset.importers.ifc.mesh_export import write_model_mesh  # noqa: E402
 from dataset.importers.import_config import ImportConfig  # noqa: E402
-from dataset.importers.mesh_import import import_labelled_mesh  # noqa: E402
+from dataset.importers.mesh.mesh_import import import_labelled_mesh  # noqa: E402
 
 FIXTURES = Path(__file__).resolve().parent.parent / "tests" / "fixtures" / "ifc_real"
 HEADER = ("| file | path | window m² | facade m² | WWR | bodies closed / all "

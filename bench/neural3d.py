@@ -37,9 +37,9 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.device import resolve_device  # noqa: E402
-from dataset.scenes.scene import read_method_input, read_scene  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.device import resolve_device  # noqa: E402
+from envelope.scenes.scene import read_method_input, read_scene  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
 from neural3d.field.trained import TrainedField, build_field  # noqa: E402
 from neural3d.train import train  # noqa: E402
@@ -156,7 +156,7 @@ def speed(args: argparse.Namespace) -> dict:
 def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.device,
                    out_dir: Path, minutes: float, stop_at_target: bool) -> dict:
     """Train one scene, measuring every ``config.eval_every`` steps; the checks and targets."""
-    from metrics.errors import building_errors
+    from metrics.score.errors import building_errors
     from neural3d.extract import measure_field
 
     truth = read_scene(scene_dir).building

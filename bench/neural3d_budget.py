@@ -35,10 +35,10 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 import torch  # noqa: E402
 
 from bench.neural3d import IOU_TARGET, WWR_TARGET_PCT, on_target, with_overrides  # noqa: E402
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.results import code_version  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.results import code_version  # noqa: E402
+from envelope.scenes.scene import read_scene  # noqa: E402
 from neural3d.config import TrainConfig, config_to_dict, preset_config  # noqa: E402
 from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint  # noqa: E402
 
@@ -65,7 +65,7 @@ def trained_run(scene_dir: Path, config: TrainConfig, out_dir: Path) -> tuple[Pa
 
 def measure_run(run_dir: Path, scene_dir: Path, resolution: int) -> dict:
     """The finished field's errors against the truth (WWR, window, facade APE %, IoU)."""
-    from metrics.errors import building_errors
+    from metrics.score.errors import building_errors
     from neural3d.extract import measure_field
     from neural3d.extraction.extract_config import ExtractConfig
     from neural3d.field.trained import load_trained_field

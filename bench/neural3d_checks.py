@@ -37,11 +37,11 @@ from bench.neural3d import (  # noqa: E402  the targets and the spread, defined 
     last_checks_spread,
     on_target,
 )
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.results import code_version  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import building_errors  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.results import code_version  # noqa: E402
+from envelope.scenes.scene import read_scene  # noqa: E402
+from metrics.score.errors import building_errors  # noqa: E402
 from neural3d.extract import measure_field  # noqa: E402
 from neural3d.extraction.extract_config import ExtractConfig  # noqa: E402
 from neural3d.field.checkpoint import snapshot_steps  # noqa: E402

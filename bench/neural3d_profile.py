@@ -42,8 +42,8 @@ import torch  # noqa: E402
 from torch.profiler import ProfilerActivity, profile, record_function  # noqa: E402
 
 from bench.neural3d import training_steps, with_overrides  # noqa: E402
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.device import resolve_device  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.device import resolve_device  # noqa: E402
 from neural3d.config import TrainConfig, preset_config  # noqa: E402
 
 LABEL = "neural3d."  # prefix of the training code's profiler labels

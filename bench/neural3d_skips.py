@@ -33,7 +33,7 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 import torch  # noqa: E402
 
 from bench.neural3d import training_state, with_overrides  # noqa: E402
-from dataset.core.atomic import write_json_atomic  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
 from neural3d.config import preset_config  # noqa: E402
 from neural3d.rendering.neus import edge_alpha, neus_alpha, weights_from_alpha  # noqa: E402
 from neural3d.rendering.occupancy import OccupancyGrid  # noqa: E402

@@ -28,11 +28,11 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.results import code_version  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import absolute_percentage_error  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.results import code_version  # noqa: E402
+from envelope.scenes.scene import read_scene  # noqa: E402
+from metrics.score.errors import absolute_percentage_error  # noqa: E402
 from neural3d.extract import semantic_mesh_of_field  # noqa: E402
 from neural3d.extraction.extract_config import ExtractConfig  # noqa: E402
 from neural3d.extraction.measure import measure_semantic_mesh  # noqa: E402

@@ -40,11 +40,11 @@ if not __package__:
 
 import torch  # noqa: E402
 
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.results import code_version  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import building_errors  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.results import code_version  # noqa: E402
+from envelope.scenes.scene import read_scene  # noqa: E402
+from metrics.score.errors import building_errors  # noqa: E402
 from neural3d.extract import measure_mesh, semantic_mesh_of_field  # noqa: E402
 from neural3d.extraction.extract_config import STAGES, ExtractConfig, without_stages  # noqa: E402
 from neural3d.extraction.meshing import SemanticMesh  # noqa: E402

@@ -31,12 +31,12 @@ if not __package__:
 
 import torch  # noqa: E402
 
-from dataset.core.atomic import write_json_atomic  # noqa: E402
-from dataset.core.footprint import geojson_to_polygon, polygon_to_geojson  # noqa: E402
-from dataset.core.results import code_version  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import footprint_iou  # noqa: E402
+from envelope.atomic import write_json_atomic  # noqa: E402
+from envelope.footprint import geojson_to_polygon, polygon_to_geojson  # noqa: E402
+from envelope.results import code_version  # noqa: E402
+from envelope.scenes.scene import read_scene  # noqa: E402
+from metrics.score.errors import footprint_iou  # noqa: E402
 from neural3d.extract import field_sdf_fn  # noqa: E402
 from neural3d.extraction.extract_config import (  # noqa: E402
     ExtractConfig,

@@ -14,7 +14,7 @@ becomes a perfect semantic field, :class:`OracleField`:
   clipped to that beyond (marching cubes reads only the cells the surface crosses); inside
   is the union of the mesh's closed bodies (ray parity per body: a chimney
   through a roof stays inside, as with the project's winding-number rule,
-  :mod:`dataset.rendering.raycast`);
+  :mod:`envelope.geometry.raycast`);
 - **class probabilities**: one-hot of the label of the nearest truth face (that
   of the nearest surface sample). The ``probability_split`` stage is then the
   identity (a triangle's split by its corners' probabilities is its split by
@@ -57,12 +57,12 @@ from scipy.spatial import cKDTree
 from tqdm import tqdm
 
 from bench.neural3d_stages import ERROR_COLUMNS, Column, markdown, measure_sets, stage_sets
-from dataset.core.atomic import write_json_atomic
-from dataset.core.classes import CLASS_NAMES, NUM_CLASSES
-from dataset.core.mesh import LabelledMesh, triangle_areas_m2
-from dataset.core.results import code_version
 from dataset.presets import PRESETS, build_building, preset_recipes
 from dataset.set_roles import PRESET_ROLES
+from envelope.atomic import write_json_atomic
+from envelope.classes import CLASS_NAMES, NUM_CLASSES
+from envelope.mesh import LabelledMesh, triangle_areas_m2
+from envelope.results import code_version
 from neural3d.config import TrainConfig
 from neural3d.extract import semantic_mesh_of_field
 from neural3d.extraction.extract_config import STAGES, ExtractConfig

@@ -4,7 +4,7 @@
     python bench/own_facades.py --data DIR --split street
 
 Per method and building: facades found, truth facades, those covered (an estimate reached
-them under the one scoring rule, :mod:`metrics.facade_scoring`), false positives, the mean
+them under the one scoring rule, :mod:`metrics.score.facade_scoring`), false positives, the mean
 facade WWR error in points over covered facades, the building WWR error in points, the
 building facade-area error (%) and the time per building. Report-only sets (heldout,
 lod3) are refused: the settings are chosen here (:mod:`dataset.set_roles`).
@@ -25,10 +25,10 @@ import numpy as np  # noqa: E402
 from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
-from dataset.core.method_input import method_input  # noqa: E402
-from dataset.scenes.scene import read_scene  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from metrics.errors import building_errors, facade_errors  # noqa: E402
+from envelope.method_input import method_input  # noqa: E402
+from envelope.scenes.scene import read_scene  # noqa: E402
+from metrics.score.errors import building_errors, facade_errors  # noqa: E402
 
 RUNS = {"2D-SS": lambda s, split: run_2dss(s, split, Wwr2dssConfig()),
         "2D-S": lambda s, split: run_2ds(s, split, Wwr2dsConfig())}

@@ -36,14 +36,14 @@ from dataset.presets import build_building, preset_recipes  # noqa: E402
 from dataset.rendering.facade_patches import facade_patches  # noqa: E402
 from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views  # noqa: E402
 from dataset.rendering.render import Raycaster, render_ground_truth, render_rgb, render_view  # noqa: E402
-from dataset.scenes.images import (  # noqa: E402
+from dataset.scenes.scene_writer import GenerateConfig, generate_scene  # noqa: E402
+from envelope.scenes.images import (  # noqa: E402
     write_depth_m,
     write_facade_ids,
     write_labels,
     write_normals,
     write_rgb,
 )
-from dataset.scenes.scene_writer import GenerateConfig, generate_scene  # noqa: E402
 
 
 def per_image(resolution: int) -> dict[str, float]:

@@ -23,14 +23,14 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from dataset.core.camera import project_world_to_image  # noqa: E402
-from dataset.importers.citygml_preset import build_lod3_building, lod3_entries  # noqa: E402
+from dataset.importers.citygml.preset import build_lod3_building, lod3_entries  # noqa: E402
 from dataset.rendering.street_views import (  # noqa: E402
     StreetConfig,
     scene_caster,
     street_stations,
     street_views,
 )
+from envelope.camera import project_world_to_image  # noqa: E402
 
 SAMPLES = 500
 SEEN = 0.5

@@ -30,15 +30,15 @@ from pathlib import Path
 
 import numpy as np
 
-from dataset.core.atomic import write_json_atomic
-from dataset.core.classes import CLASS_NAMES, SemanticClass
-from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
-from dataset.core.scene_record import Frame, Scene
-from dataset.importers.buildnet3d import write_atomically
-from dataset.importers.meta_data import BUILDNET3D_LAYOUT, write_meta_data
-from dataset.scenes.images import read_rgb, write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import read_scene
-from dataset.scenes.scene_validation import read_frame_depth_m, read_frame_labels
+from dataset.importers.buildnet3d.buildnet3d import write_atomically
+from dataset.importers.buildnet3d.meta_data import BUILDNET3D_LAYOUT, write_meta_data
+from envelope.atomic import write_json_atomic
+from envelope.classes import CLASS_NAMES, SemanticClass
+from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import read_rgb, write_depth_m, write_labels, write_rgb
+from envelope.scenes.scene import read_scene
+from envelope.scenes.scene_validation import read_frame_depth_m, read_frame_labels
 
 EXPORT_SPLITS = (TRAIN_PROTOCOL, EVAL_SPLIT)
 DEPTH_UNIT_M = 0.001

@@ -23,10 +23,6 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
-from dataset.executors.ray_tasks import RayConfig, add_executor_arguments
-from dataset.executors.worker_pool import worker_pool
 from dataset.importers.source import BuildingEntry, Entry, NoOptions, SceneEntry, write_scenes
 from dataset.rendering.street_views import STREET_FRAMES_PER_BUILDING, StreetConfig
 from dataset.scenes.scene_writer import (
@@ -46,6 +42,10 @@ from dataset.source_args import (
     source_options,
 )
 from dataset.sources import PRESET_SOURCE, SOURCES
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.executors.ray_tasks import RayConfig, add_executor_arguments
+from envelope.executors.worker_pool import worker_pool
+from envelope.resources import FACADE_VIEWS_PER_BUILDING, check_generate_resources
 
 __all__ = [
     "GenerateConfig",

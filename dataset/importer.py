@@ -12,12 +12,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.mesh import write_labelled_ply
-from dataset.core.truth import write_building
-from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE
+from dataset.importers.mesh.building_file import IFC_SOURCE, MESH_SOURCE
 from dataset.importers.source import pick_source
 from dataset.source_args import add_import_arguments, source_options
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.mesh import write_labelled_ply
+from envelope.truth import write_building
 
 BUILDING_FILES = (MESH_SOURCE, IFC_SOURCE)
 

@@ -12,7 +12,7 @@ a model; :func:`build_building` turns it into mesh + truth deterministically
   designs of :mod:`dataset.families.heldout` (family realistic);
 - ``lod3``: 49 real buildings, the Ingolstadt LoD3 CityGML models that have windows
   (family ``citygml``; files in ``dataset/examples/lod3_ingolstadt``, CC BY-SA 4.0,
-  :mod:`dataset.importers.citygml_preset`).
+  :mod:`dataset.importers.citygml.preset`).
 - ``segtrain``: 24 skyscrapers and 24 L-shaped buildings that are never evaluated, the
   training set of the mask segmenter (``segment/``); no realistic building (its four
   designs, only jittered, are the evaluated ones).
@@ -35,14 +35,14 @@ from typing import Literal
 import numpy as np
 from tqdm import tqdm
 
-from dataset.core.cli_errors import add_debug_flag, run_cli
-from dataset.core.truth import Building, BuildingTruth
 from dataset.families.heldout import make_heldout, sample_heldout_params
 from dataset.families.heldout_params import HELDOUT_MODELS
 from dataset.families.l_shaped import make_l_shaped, sample_l_shaped_params
 from dataset.families.realistic import make_realistic, sample_realistic_params
 from dataset.families.realistic_params import REALISTIC_MODELS
 from dataset.families.skyscraper import make_skyscraper, sample_skyscraper_params
+from envelope.cli_errors import add_debug_flag, run_cli
+from envelope.truth import Building, BuildingTruth
 
 Family = Literal["skyscraper", "l_shaped", "realistic", "citygml"]
 FAMILIES: tuple[str, ...] = ("skyscraper", "l_shaped", "realistic", "citygml")
@@ -148,7 +148,7 @@ def preset_recipes(name: str) -> tuple[BuildingRecipe, ...]:
         ]
         return tuple(recipes)
     if name == "lod3":
-        from dataset.importers.citygml_preset import lod3_entries
+        from dataset.importers.citygml.preset import lod3_entries
 
         return tuple(BuildingRecipe(e.id, "citygml", _LOD3_SEED + k, e.file)
                      for k, e in enumerate(lod3_entries()))
@@ -166,7 +166,7 @@ def build_building(recipe: BuildingRecipe) -> Building:
     if not isinstance(recipe, BuildingRecipe):
         raise ValueError(f"build_building needs a BuildingRecipe, got {type(recipe).__name__}")
     if recipe.family == "citygml":
-        from dataset.importers.citygml_preset import build_lod3_building
+        from dataset.importers.citygml.preset import build_lod3_building
 
         return build_lod3_building(recipe.id, recipe.model)
     rng = np.random.default_rng(recipe.seed)

@@ -3,7 +3,7 @@
 Each task builds its building from its entry (:class:`dataset.importers.source.BuildingEntry`:
 a preset's recipe, nothing read from this machine's files), renders the scene folder into
 a temporary folder on the worker and returns it packed
-(:mod:`dataset.executors.folder_pack`); this process unpacks it into ``out_root``
+(:mod:`envelope.executors.folder_pack`); this process unpacks it into ``out_root``
 atomically, so a folder with the final name is always finished, and a rerun
 skips it. A building that fails (it cannot be framed) stops the run as with
 the local pool: the tasks not yet collected are cancelled.
@@ -15,11 +15,11 @@ import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from dataset.core.atomic import atomic_directory
-from dataset.executors.folder_pack import pack_folder, unpack_folder
-from dataset.executors.ray_tasks import RayConfig, TaskLost, TaskResources, ray_session, run_tasks
 from dataset.importers.source import BuildingEntry
 from dataset.scenes.scene_writer import GenerateConfig, generate_scene
+from envelope.atomic import atomic_directory
+from envelope.executors.folder_pack import pack_folder, unpack_folder
+from envelope.executors.ray_tasks import RayConfig, TaskLost, TaskResources, ray_session, run_tasks
 
 RENDER_RESOURCES = TaskResources(cpus=1.0)  # embree renders a building on one core here
 

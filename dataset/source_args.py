@@ -18,8 +18,8 @@ from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
-from dataset.importers.building_file import BuildingFileOptions
 from dataset.importers.import_config import ImportConfig
+from dataset.importers.mesh.building_file import BuildingFileOptions
 from dataset.importers.source import NoOptions, Source, pick_source
 
 _IMPORT_HELP = {

@@ -13,10 +13,10 @@ from __future__ import annotations
 from functools import partial
 from pathlib import Path
 
-from dataset.importers.blenderproc import BLENDERPROC_SOURCE
-from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE
-from dataset.importers.buildnet3d import BUILDNET3D_SOURCE
-from dataset.importers.citygml_source import CITYGML_SOURCE
+from dataset.importers.buildnet3d.blenderproc import BLENDERPROC_SOURCE
+from dataset.importers.buildnet3d.buildnet3d import BUILDNET3D_SOURCE
+from dataset.importers.citygml.source import CITYGML_SOURCE
+from dataset.importers.mesh.building_file import IFC_SOURCE, MESH_SOURCE
 from dataset.importers.source import BuildingEntry, NoOptions, Source
 
 

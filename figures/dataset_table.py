@@ -6,10 +6,10 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
-from dataset.core.truth import BuildingTruth, read_building
+from envelope.truth import BuildingTruth, read_building
 from figures.style import MissingInput
-from metrics.aggregate import ALL_FAMILIES, family_rank
-from metrics.tables import Table
+from metrics.report.tables import Table
+from metrics.score.aggregate import ALL_FAMILIES, family_rank
 
 TABLE1_NAME = "table1_dataset"
 

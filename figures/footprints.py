@@ -14,11 +14,11 @@ import numpy as np
 from matplotlib.figure import Figure
 from shapely.geometry import MultiPolygon, Polygon
 
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.truth import BuildingTruth
+from envelope.footprint import geojson_to_polygon
+from envelope.truth import BuildingTruth
 from figures.style import MissingInput
-from metrics.errors import footprint_iou
-from metrics.plots import save_figure
+from metrics.report.plots import save_figure
+from metrics.score.errors import footprint_iou
 
 
 def footprint_pairs(

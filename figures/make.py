@@ -15,21 +15,21 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from dataset.benchmark_cache import DefaultBenchmark
-from dataset.core.atomic import write_json_atomic
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.results import code_version
+from envelope.atomic import write_json_atomic
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.results import code_version
 from figures.dataset_table import read_truths, table1_dataset
 from figures.footprints import footprint_pairs, plot_footprint_overlays
 from figures.meshes import plot_reconstructed_meshes, reconstructed_meshes
 from figures.pipeline import plot_2dss_pipeline
 from figures.renders import plot_example_renders
 from figures.style import MissingInput
-from metrics.aggregate import aggregate_by_family
 from metrics.compare import FOOTPRINTS_FOLDER, PIPELINE_FOLDER, PROVENANCE_FILE
-from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
-from metrics.report import PER_BUILDING_NAME, read_building_errors_csv
-from metrics.runner import find_scenes
-from metrics.tables import write_table
+from metrics.report.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.report.report import PER_BUILDING_NAME, read_building_errors_csv
+from metrics.report.tables import write_table
+from metrics.run.runner import find_scenes
+from metrics.score.aggregate import aggregate_by_family
 
 FIGURES_PROVENANCE = "figures_provenance.json"
 

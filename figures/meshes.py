@@ -1,7 +1,7 @@
 """Reconstructed semantic meshes (neural3d's) rendered from a few angles, beside the true mesh.
 
 Reads the ``<method>_runs.json`` files that ``metrics.compare`` writes for
-methods that keep a mesh (neural3d; :mod:`metrics.mesh_pointers`) and, when
+methods that keep a mesh (neural3d; :mod:`metrics.run.mesh_pointers`) and, when
 the scene is there, the scene's true ``mesh.ply``.
 Rendering is exact ray casting (:mod:`dataset.rendering.render`) with class colours and
 simple Lambert shading.
@@ -16,14 +16,14 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.classes import NO_FACADE
-from dataset.core.mesh import LabelledMesh, read_labelled_ply
-from dataset.core.semantic_ply import read_semantic_ply
 from dataset.rendering.render import Raycaster, render_ground_truth
+from envelope.camera import Intrinsics, look_at
+from envelope.classes import NO_FACADE
+from envelope.mesh import LabelledMesh, read_labelled_ply
+from envelope.semantic_ply import read_semantic_ply
 from figures.style import CLASS_RGB_ARRAY, MissingInput
-from metrics.mesh_pointers import read_mesh_pointers
-from metrics.plots import save_figure
+from metrics.report.plots import save_figure
+from metrics.run.mesh_pointers import read_mesh_pointers
 
 
 @dataclass(frozen=True)

@@ -10,9 +10,9 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
-from dataset.scenes.images import read_rgb
+from envelope.scenes.images import read_rgb
 from figures.style import MissingInput
-from metrics.plots import save_figure
+from metrics.report.plots import save_figure
 
 STEPS = (("mask", "facade mask"), ("corners", "corners"), ("rectified", "rectified facade"))
 

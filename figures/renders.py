@@ -8,14 +8,14 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from dataset.core.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
-from dataset.core.scene_record import Frame, Scene
-from dataset.core.truth import BuildingTruth
-from dataset.scenes.images import read_depth_m, read_labels, read_normals, read_rgb
-from dataset.scenes.scene import read_scene
+from envelope.protocols import EVAL_SPLIT, IDEAL_PROTOCOL, MULTI_PROTOCOL, TRAIN_PROTOCOL
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import read_depth_m, read_labels, read_normals, read_rgb
+from envelope.scenes.scene import read_scene
+from envelope.truth import BuildingTruth
 from figures.style import MissingInput, colour_depth, colour_labels, colour_normals
-from metrics.aggregate import family_rank
-from metrics.plots import save_figure
+from metrics.report.plots import save_figure
+from metrics.score.aggregate import family_rank
 
 MODALITIES = ("colour", "semantics", "normals", "depth")
 # an orbit view shows the whole building

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import CLASS_RGB, NUM_CLASSES, UNKNOWN_CLASS_RGB
+from envelope.classes import CLASS_RGB, NUM_CLASSES, UNKNOWN_CLASS_RGB
 
 CLASS_RGB_ARRAY = np.array(CLASS_RGB, dtype=np.uint8)  # (NUM_CLASSES, 3)
 
@@ -14,7 +14,7 @@ class MissingInput(ValueError):
 
 
 def colour_labels(labels: np.ndarray) -> np.ndarray:
-    """(H, W) class ids -> (H, W, 3) uint8 colours (:data:`dataset.core.classes.CLASS_RGB`)."""
+    """(H, W) class ids -> (H, W, 3) uint8 colours (:data:`envelope.classes.CLASS_RGB`)."""
     palette = np.tile(np.array(UNKNOWN_CLASS_RGB, dtype=np.uint8), (256, 1))
     palette[:NUM_CLASSES] = CLASS_RGB
     return palette[np.asarray(labels, dtype=np.uint8)]

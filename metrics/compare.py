@@ -8,13 +8,13 @@ Markdown and LaTeX, per-building and per-facade CSVs, plots (PNG + PDF),
 ``provenance.json``, the estimated footprints, the pipeline images of one facade
 (of the first method that writes them) and, for each method that keeps a mesh,
 ``<method>_runs.json`` pointing at its meshes: everything ``figures.make`` reads;
-then ``report.html``, all of it in one offline page (:mod:`metrics.html_report`).
+then ``report.html``, all of it in one offline page (:mod:`metrics.report.html_report`).
 
 Its modes are small functions: :func:`compare_once` (with ``--degrade``, on
 degraded inputs), :func:`compare_on_masks` (``--masks predicted[:MODEL]``, on a
 segmenter's masks beside the exact ones), :func:`robustness_study`
 (``--robustness``) and :func:`explain_one` (``--explain``); ``main`` works out the folders once
-(:func:`metrics.compare_args.compare_request`).
+(:func:`metrics.run.compare_args.compare_request`).
 """
 
 from __future__ import annotations
@@ -28,22 +28,48 @@ from functools import partial
 from pathlib import Path
 
 from dataset.benchmark_cache import ensure_benchmark
-from dataset.core.atomic import write_json_atomic, write_text_atomic
-from dataset.core.cli_errors import check_output_folder, exit_cli, run_cli
-from dataset.core.method import available_methods
-from dataset.core.results import code_version
-from dataset.core.truth import BuildingTruth, read_building
-from dataset.executors.ray_tasks import RayConfig
-from metrics.aggregate import GroupSummary, aggregate_by_family
-from metrics.compare_args import CompareRequest, compare_request, parse_compare_args
-from metrics.compare_outputs import (
+from envelope.atomic import write_json_atomic, write_text_atomic
+from envelope.cli_errors import check_output_folder, exit_cli, run_cli
+from envelope.executors.ray_tasks import RayConfig
+from envelope.method import available_methods
+from envelope.results import code_version
+from envelope.truth import BuildingTruth, read_building
+from metrics.predicted_masks import compare_on_predicted_masks
+from metrics.report.compare_outputs import (
     keep_pipeline_images,
     write_footprints,
     write_html_report,
     write_plots,
 )
-from metrics.degraded import degraded_run, with_degradation
-from metrics.errors import (
+from metrics.report.report import (
+    per_building_table,
+    per_facade_table,
+    table2_errors,
+    table3_footprint_iou,
+    timing_table,
+)
+from metrics.report.report_facades import FACADE_SCORES_NAME, facade_scores_table
+from metrics.report.report_orientation import orientation_table
+from metrics.report.report_paper import (
+    PAPER_TABLE2_NAME,
+    PAPER_TABLE3_NAME,
+    paper_table2_comparison,
+    paper_table3_comparison,
+)
+from metrics.report.report_seeds import SEED_TABLE_NAME, seed_spread_table
+from metrics.report.report_visible import TABLE2_VISIBLE_NAME, table2_visible_errors
+from metrics.report.tables import Table, to_csv, to_text, write_table
+from metrics.robustness import RobustnessStudy, robustness_table, run_study
+from metrics.run.compare_args import CompareRequest, compare_request, parse_compare_args
+from metrics.run.degraded import degraded_run, with_degradation
+from metrics.run.executors import make_executor
+from metrics.run.explain import explain, methods_provenance_text, recorded_steps, run_timings
+from metrics.run.mesh_pointers import write_mesh_pointers
+from metrics.run.methods import list_methods, method_specs
+from metrics.run.predicted_masks import masks_segmenter
+from metrics.run.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
+from metrics.score.aggregate import GroupSummary, aggregate_by_family
+from metrics.score.errors import (
     NO_TRUTH_FAMILY,
     BuildingErrors,
     FacadeErrors,
@@ -51,36 +77,11 @@ from metrics.errors import (
     facade_errors,
     missed_facades,
 )
-from metrics.errors import failed_building as failed_row
-from metrics.executors import make_executor
-from metrics.explain import explain, methods_provenance_text, recorded_steps, run_timings
-from metrics.mesh_pointers import write_mesh_pointers
-from metrics.methods import list_methods, method_specs
-from metrics.orientation_errors import (
+from metrics.score.errors import failed_building as failed_row
+from metrics.score.orientation_errors import (
     orientation_errors_of,
-    orientation_table,
     summarise_orientations,
 )
-from metrics.predicted_masks import compare_on_predicted_masks, masks_segmenter
-from metrics.report import (
-    per_building_table,
-    per_facade_table,
-    table2_errors,
-    table3_footprint_iou,
-    timing_table,
-)
-from metrics.report_facades import FACADE_SCORES_NAME, facade_scores_table
-from metrics.report_paper import (
-    PAPER_TABLE2_NAME,
-    PAPER_TABLE3_NAME,
-    paper_table2_comparison,
-    paper_table3_comparison,
-)
-from metrics.report_seeds import SEED_TABLE_NAME, seed_spread_table
-from metrics.report_visible import TABLE2_VISIBLE_NAME, table2_visible_errors
-from metrics.robustness import RobustnessStudy, robustness_table, run_study
-from metrics.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
-from metrics.tables import Table, to_csv, to_text, write_table
 
 PROVENANCE_FILE = "provenance.json"
 PIPELINE_FOLDER = "2dss_pipeline"

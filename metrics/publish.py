@@ -19,9 +19,9 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from dataset.core.atomic import atomic_directory, write_json_atomic
-from dataset.core.cli_errors import exit_cli, run_cli
-from dataset.core.provenance import code_fingerprint
+from envelope.atomic import atomic_directory, write_json_atomic
+from envelope.cli_errors import exit_cli, run_cli
+from envelope.provenance import code_fingerprint
 
 RECORD_FILE = "RECORD.json"
 TABLES_ROOT = Path("docs/measurements/tables")

@@ -1,7 +1,7 @@
 """The robustness study (``python -m metrics.compare --robustness``): error against severity.
 
 For each degradation and severity of a :class:`RobustnessStudy` the comparison
-runs on degraded inputs (:mod:`metrics.degraded`); severity 0 is the clean
+runs on degraded inputs (:mod:`metrics.run.degraded`); severity 0 is the clean
 comparison. The study writes ``robustness.csv`` / ``.md`` (mean WWR, window
 and facade APE per method, views, degradation and severity, pooled over
 buildings) and ``robustness.png`` / ``.pdf`` (one panel per degradation, one
@@ -15,14 +15,14 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from dataset.core.atomic import write_text_atomic
 from dataset.degrade.spec import DegradeSpec
-from metrics.aggregate import method_rank, protocol_rank
-from metrics.degraded import degraded_run, with_degradation
-from metrics.errors import BuildingErrors
-from metrics.robustness_plot import RobustnessRow, plot_robustness
-from metrics.runner import MethodSpec
-from metrics.tables import Table, to_csv, to_markdown
+from envelope.atomic import write_text_atomic
+from metrics.report.robustness_plot import RobustnessRow, plot_robustness
+from metrics.report.tables import Table, to_csv, to_markdown
+from metrics.run.degraded import degraded_run, with_degradation
+from metrics.run.runner import MethodSpec
+from metrics.score.aggregate import method_rank, protocol_rank
+from metrics.score.errors import BuildingErrors
 
 SpecsFor = Callable[[Path], list[MethodSpec]]
 """results folder -> the method specs to run there."""

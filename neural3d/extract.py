@@ -3,17 +3,17 @@
 ``python -m neural3d.extract --run DIR`` writes, into ``DIR/extract`` (or ``--out``):
 
 - ``mesh.ply``: marching-cubes mesh, per-vertex ``label`` (argmax of the semantic
-  head, mapped to :mod:`dataset.core.classes` ids by the run's class names) and RGB
+  head, mapped to :mod:`envelope.classes` ids by the run's class names) and RGB
   from the colour network looking at the surface head-on (view direction =
   -vertex normal, so the colour does not depend on where a camera happened to be);
 - ``footprint.geojson``: zero contour of the SDF averaged over ``footprint_heights_m``,
   its straight runs straightened (:mod:`neural3d.extraction.straight_walls`);
-- ``<scene>__neural3d__train.json``: the :class:`dataset.core.results.MethodResult`.
+- ``<scene>__neural3d__train.json``: the :class:`envelope.results.MethodResult`.
 
 Facades are the mesh's own facade groups (:mod:`neural3d.extraction.measure`), numbered
 1..K, each with its outward normal and centre in world metres; nothing of the
 ground truth is read. Evaluation pairs them with the truth's facades
-(:mod:`metrics.facade_match`).
+(:mod:`metrics.score.facade_match`).
 """
 
 from __future__ import annotations
@@ -26,15 +26,15 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from dataset.core.atomic import write_json_atomic
-from dataset.core.classes import NUM_CLASSES, class_id_from_name
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.device import resolve_device
-from dataset.core.footprint import polygon_to_geojson
-from dataset.core.protocols import TRAIN_PROTOCOL
-from dataset.core.resources import check_mesh_resources
-from dataset.core.results import FacadeEstimate, MethodResult, code_version, write_result
-from dataset.core.semantic_ply import write_semantic_ply
+from envelope.atomic import write_json_atomic
+from envelope.classes import NUM_CLASSES, class_id_from_name
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.device import resolve_device
+from envelope.footprint import polygon_to_geojson
+from envelope.protocols import TRAIN_PROTOCOL
+from envelope.resources import check_mesh_resources
+from envelope.results import FacadeEstimate, MethodResult, code_version, write_result
+from envelope.semantic_ply import write_semantic_ply
 from neural3d.extraction.extract_config import (
     STAGES,
     ExtractConfig,
@@ -70,7 +70,7 @@ def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
 
 def field_probability_fn(trained, device: torch.device, chunk_points: int):
     """NumPy callable (N, 3) world m -> (N, NUM_CLASSES) class probabilities of a
-    ``TrainedField``'s semantic head (softmax), in :mod:`dataset.core.classes` id order;
+    ``TrainedField``'s semantic head (softmax), in :mod:`envelope.classes` id order;
     classes the run does not know have probability 0."""
     class_ids = _class_ids_of(trained.class_names)
 
@@ -89,7 +89,7 @@ def field_probability_fn(trained, device: torch.device, chunk_points: int):
 
 
 def field_label_fn(trained, device: torch.device, chunk_points: int) -> LabelFn:
-    """NumPy class-id callable (N, 3) -> (N,) :mod:`dataset.core.classes` ids (semantic-head
+    """NumPy class-id callable (N, 3) -> (N,) :mod:`envelope.classes` ids (semantic-head
     argmax)."""
     probabilities = field_probability_fn(trained, device, chunk_points)
 

@@ -1,4 +1,4 @@
-"""neural3d as a benchmark method (:class:`dataset.core.method.Method`): train, then extract.
+"""neural3d as a benchmark method (:class:`envelope.method.Method`): train, then extract.
 
 Its config, :class:`Neural3dBudget`, is the step budget and the few settings a
 comparison chooses; the training and extraction configs follow from it
@@ -16,12 +16,12 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
-from dataset.core.method import Method
-from dataset.core.method_input import MethodInput, require_method_input
-from dataset.core.method_options import Option
-from dataset.core.protocols import TRAIN_PROTOCOL
-from dataset.core.results import MethodResult
-from dataset.core.scene_record import scene_name
+from envelope.method import Method
+from envelope.method_input import MethodInput, require_method_input
+from envelope.method_options import Option
+from envelope.protocols import TRAIN_PROTOCOL
+from envelope.results import MethodResult
+from envelope.scene_record import scene_name
 from neural3d.config import TrainConfig, config_to_dict, preset_config
 from neural3d.extraction.extract_config import ExtractConfig
 
@@ -119,7 +119,7 @@ def trained_scene_dirs(runs: list[Path]) -> list[Path]:
 
 def check_budget(budget: Neural3dBudget, runs_here: bool) -> None:
     """Refuse a device that is not a torch CPU/CUDA device, or (``runs_here``) not here."""
-    from dataset.core.device import resolve_device
+    from envelope.device import resolve_device
 
     resolve_device(budget.device, available=runs_here)
 

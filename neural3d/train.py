@@ -20,15 +20,15 @@ from pathlib import Path
 
 import torch
 
-from dataset.core.atomic import write_json_atomic
-from dataset.core.classes import CLASS_NAMES
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.device import resolve_device
-from dataset.core.progress import progress_bar
-from dataset.core.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
-from dataset.core.resources import check_training_resources
-from dataset.core.scene_record import scene_name
-from dataset.scenes.scene import read_method_input
+from envelope.atomic import write_json_atomic
+from envelope.classes import CLASS_NAMES
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.device import resolve_device
+from envelope.progress import progress_bar
+from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
+from envelope.resources import check_training_resources
+from envelope.scene_record import scene_name
+from envelope.scenes.scene import read_method_input
 from neural3d.config import PRESETS, TrainConfig, preset_config
 from neural3d.field.checkpoint import (
     CHECKPOINT_NAME,

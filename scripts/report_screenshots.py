@@ -4,7 +4,7 @@
 
 DIR is a comparison's output folder holding report.html (``python -m
 metrics.compare`` writes it). Opens the report in headless Chromium with the
-network blocked (metrics.report_browser), saves the tables, the charts and one
+network blocked (metrics.report.report_browser), saves the tables, the charts and one
 building's details with its neural3d mesh, and prints the file size, the time
 to the load event and the time until the charts are drawn.
 """
@@ -17,8 +17,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from metrics.html_report import REPORT_FILE
-from metrics.report_browser import open_report
+from metrics.report.html_report import REPORT_FILE
+from metrics.report.report_browser import open_report
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 
 IGNORE_LABEL = 255
 """Label of pixels that carry no training signal (outside the image after a crop)."""

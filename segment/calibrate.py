@@ -27,8 +27,8 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from dataset.core.classes import NUM_CLASSES, SemanticClass
-from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
+from envelope.classes import NUM_CLASSES, SemanticClass
+from envelope.cli_errors import add_debug_flag, exit_cli, run_cli
 from segment.evaluate import evenly_spaced
 from segment.network import UNet
 from segment.segmenter import predict_logits

@@ -22,10 +22,10 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from dataset.core.atomic import write_text_atomic
-from dataset.core.classes import CLASS_NAMES
-from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
-from dataset.core.provenance import code_version
+from envelope.atomic import write_text_atomic
+from envelope.classes import CLASS_NAMES
+from envelope.cli_errors import add_debug_flag, exit_cli, run_cli
+from envelope.provenance import code_version
 from segment.evaluate import evenly_spaced
 from segment.real_measure import (
     WWR_BANDS_POINTS,

@@ -15,7 +15,7 @@ import torch
 from torch import Tensor, nn
 from torch.nn import functional as F
 
-from dataset.core.classes import NUM_CLASSES
+from envelope.classes import NUM_CLASSES
 
 # RGB in [0, 1] is centred and scaled to about unit spread before the first convolution.
 _INPUT_MEAN, _INPUT_SCALE = 0.5, 4.0

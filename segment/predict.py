@@ -23,8 +23,8 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.scenes.images import write_labels
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.scenes.images import write_labels
 from segment.scene_masks import predicted_scene, scene_folders
 from segment.segmenter import Segmenter, resolve_segmenter, segment_photo
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.classes import NUM_CLASSES, SemanticClass
+from envelope.classes import NUM_CLASSES, SemanticClass
 from segment.evaluate import confusion_matrix, iou_per_class
 from segment.real_sets import IGNORED, RealPhoto, read_photo_pair
 from segment.segmenter import Segmenter, segment_rgb

@@ -25,18 +25,18 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from dataset.core.atomic import atomic_directory
-from dataset.core.classes import CLASS_NAMES
-from dataset.core.provenance import (
+from dataset.degrade.scene_copy import link_tree
+from envelope.atomic import atomic_directory
+from envelope.classes import CLASS_NAMES
+from envelope.provenance import (
     Provenance,
     file_fingerprint,
     make_provenance,
     provenance_changes,
 )
-from dataset.core.scene_record import Frame
-from dataset.degrade.scene_copy import link_tree
-from dataset.scenes.images import write_labels
-from dataset.scenes.scene import read_scene, write_transforms
+from envelope.scene_record import Frame
+from envelope.scenes.images import write_labels
+from envelope.scenes.scene import read_scene, write_transforms
 from segment.photo_io import read_photo_rgb
 from segment.segmenter import Segmenter, segment_rgb
 

@@ -24,8 +24,8 @@ from typing import Any
 import numpy as np
 import torch
 
-from dataset.core.classes import CLASS_NAMES, NUM_CLASSES
-from dataset.core.provenance import code_fingerprint, file_fingerprint, library_version
+from envelope.classes import CLASS_NAMES, NUM_CLASSES
+from envelope.provenance import code_fingerprint, file_fingerprint, library_version
 from segment.network import UNet
 from segment.photo_io import read_photo_rgb
 from segment.weights import DEFAULT_WEIGHTS, load_network

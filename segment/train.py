@@ -29,9 +29,9 @@ import torch
 from torch.nn import functional as F
 from tqdm import tqdm
 
-from dataset.core.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
-from dataset.core.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
-from dataset.core.provenance import file_fingerprint, make_provenance
+from envelope.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
+from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
+from envelope.provenance import file_fingerprint, make_provenance
 from segment.augment import IGNORE_LABEL, REAL_PHOTO_AUGMENT, AugmentConfig
 from segment.evaluate import confusion_matrix, evenly_spaced, iou_per_class, mean_iou
 from segment.network import UNet, UNetConfig
@@ -128,7 +128,7 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
             inputs["real_split_lists"] = {n: file_fingerprint(LIST_DIR / f"{n}.csv")
                                           for n in real}
         provenance = make_provenance(
-            asdict(config), modules=("segment", "dataset"), inputs=inputs,
+            asdict(config), modules=("segment", "envelope", "dataset"), inputs=inputs,
             libraries=("torch", "numpy", "opencv-contrib-python-headless"))
         rng = np.random.default_rng(config.seed)
         torch.manual_seed(config.seed)

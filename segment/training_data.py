@@ -17,13 +17,13 @@ from typing import Any
 import numpy as np
 import torch
 
-from dataset.core.classes import NUM_CLASSES
-from dataset.core.provenance import file_fingerprint
-from dataset.core.scene_record import Frame, Scene
 from dataset.presets import PRESETS, preset_recipes
-from dataset.scenes.images import read_rgb
-from dataset.scenes.scene import read_scene
-from dataset.scenes.scene_validation import read_frame_labels
+from envelope.classes import NUM_CLASSES
+from envelope.provenance import file_fingerprint
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import read_rgb
+from envelope.scenes.scene import read_scene
+from envelope.scenes.scene_validation import read_frame_labels
 from segment.augment import IGNORE_LABEL, AugmentConfig, augment_frame
 from segment.scene_masks import scene_folders
 

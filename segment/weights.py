@@ -7,7 +7,7 @@ format tag, the class names it was trained for, the :class:`UNetConfig`, the wei
 A copy of the record is written beside it as ``<name>.json`` for people to read.
 :func:`load_network` refuses, with a message that says what to do, a missing,
 truncated or foreign file and weights trained for other classes than
-:data:`dataset.core.classes.CLASS_NAMES`.
+:data:`envelope.classes.CLASS_NAMES`.
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from typing import Any
 
 import torch
 
-from dataset.core.atomic import write_bytes_atomic, write_json_atomic
-from dataset.core.classes import CLASS_NAMES
+from envelope.atomic import write_bytes_atomic, write_json_atomic
+from envelope.classes import CLASS_NAMES
 from segment.network import UNet, UNetConfig
 
 WEIGHTS_FORMAT = "envelope-bench-segmenter-1"
@@ -77,7 +77,7 @@ def load_network(path: str | Path = DEFAULT_WEIGHTS) -> tuple[UNet, dict[str, An
     classes = tuple(archive.get("classes") or ())
     if classes != CLASS_NAMES:
         raise ValueError(f"{path} was trained for the classes {list(classes)}, but this project "
-                         f"segments {list(CLASS_NAMES)} (dataset.core.classes); {_TRAIN_HINT}")
+                         f"segments {list(CLASS_NAMES)} (envelope.classes); {_TRAIN_HINT}")
     try:
         model = UNet(UNetConfig(**archive["network"]))
         model.load_state_dict({k: v.float() if v.is_floating_point() else v

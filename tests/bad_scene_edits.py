@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dataset.scenes.images import read_labels, write_depth_m, write_labels, write_rgb
+from envelope.scenes.images import read_labels, write_depth_m, write_labels, write_rgb
 
 Edit = Callable[[Path], None]
 IDEAL = "ideal_0000.png"  # the first ideal view: the baselines read it

@@ -7,7 +7,7 @@ With ``gable_m`` > 0 a triangular gable of that height tops the facade;
 ``balconies`` (z0, z1) are full-width class-"other" panels 1.2 m in front of it.
 An optional neighbour facade at x = L, y in [0, neighbour_m], faces +x, and the
 ground z = 0 is background with depth. Every image comes from ray-plane
-intersections through pixel centres (dataset.core.camera.rays_world), so it is exact.
+intersections through pixel centres (envelope.camera.rays_world), so it is exact.
 """
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, look_at, rays_world
-from dataset.core.classes import SemanticClass
-from dataset.core.scene_record import Frame, Scene
-from dataset.scenes.images import write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import write_transforms
+from envelope.camera import Intrinsics, look_at, rays_world
+from envelope.classes import SemanticClass
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import write_depth_m, write_labels, write_rgb
+from envelope.scenes.scene import write_transforms
 
 BALCONY_M = 1.2  # balcony panels stand this far in front of the facade
 GROUND_RANGE_M = 50.0  # the ground ends here, so that depth fits a 16-bit PNG in mm

@@ -10,10 +10,10 @@ import json
 import cv2
 import numpy as np
 
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.classes import SemanticClass as C
 from dataset.rendering.render import render_view
-from dataset.scenes.labels import class_mapping
+from envelope.camera import Intrinsics, look_at
+from envelope.classes import SemanticClass as C
+from envelope.scenes.labels import class_mapping
 
 RENDERER = class_mapping("renderer")
 BPROC_ID = {C.BACKGROUND: 0, C.WALL: 1, C.DOOR: 2, C.WINDOW: 3, C.ROOF: 4, C.OTHER: 5}

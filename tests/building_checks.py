@@ -14,10 +14,10 @@ import trimesh
 from shapely.geometry import MultiLineString, Polygon
 from shapely.ops import polygonize, unary_union
 
-from dataset.core.classes import NO_FACADE, SemanticClass
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.mesh import area_by_class_m2
-from dataset.core.truth import Building
+from envelope.classes import NO_FACADE, SemanticClass
+from envelope.footprint import geojson_to_polygon
+from envelope.mesh import area_by_class_m2
+from envelope.truth import Building
 
 AREA_RTOL = 1e-6  # the task's bound; vertex merging rounds to 1 nm, so errors are ~1e-9
 FOOTPRINT_MIN_IOU = 0.999

@@ -23,14 +23,14 @@ import numpy as np
 import pytest
 from shapely.geometry import box as shapely_box
 
-from dataset.core.classes import NO_FACADE, SemanticClass
-from dataset.core.footprint import polygon_to_geojson
-from dataset.core.mesh import LabelledMesh, concatenate_meshes
-from dataset.core.truth import Building, BuildingTruth, FacadeTruth
-from dataset.core.wwr import ClassAreas
 from dataset.generate import GenerateConfig, generate_preset
-from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import generate_scene
+from envelope.classes import NO_FACADE, SemanticClass
+from envelope.footprint import polygon_to_geojson
+from envelope.mesh import LabelledMesh, concatenate_meshes
+from envelope.scenes.scene import read_scene
+from envelope.truth import Building, BuildingTruth, FacadeTruth
+from envelope.wwr import ClassAreas
 
 BOX_SIZE_M = (20.0, 12.0, 9.0)
 BOX_FLOORS = 3

@@ -18,9 +18,9 @@ import math
 import numpy as np
 from shapely.geometry import Polygon
 
-from dataset.core.footprint import polygon_to_geojson
-from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.truth import BuildingTruth, FacadeTruth
+from envelope.footprint import polygon_to_geojson
+from envelope.results import FacadeEstimate, MethodResult
+from envelope.truth import BuildingTruth, FacadeTruth
 
 TURN_DEG = 30.0  # the walls' turn in the world frame, clockwise seen from above
 NORTH_DEG = 20.0  # the stated north: true north to world +y, clockwise

@@ -9,10 +9,10 @@ from pathlib import Path
 
 from shapely.geometry import box
 
-from dataset.core.footprint import polygon_to_geojson
-from dataset.core.protocols import VIEW_PROTOCOLS
-from dataset.core.results import FacadeEstimate, MethodResult, write_result
-from dataset.core.truth import BuildingTruth, FacadeTruth, write_building
+from envelope.footprint import polygon_to_geojson
+from envelope.protocols import VIEW_PROTOCOLS
+from envelope.results import FacadeEstimate, MethodResult, write_result
+from envelope.truth import BuildingTruth, FacadeTruth, write_building
 
 # Two facades: (window, wall, door) m² -> gross 40 and 20 m², both WWR 0.25; total 15 / 60.
 FACADES = ((10.0, 30.0, 0.0), (5.0, 13.0, 2.0))

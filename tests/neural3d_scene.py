@@ -10,12 +10,12 @@ from pathlib import Path
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.scene_record import Frame, Scene
-from dataset.core.truth import Building
 from dataset.rendering.render import Raycaster, RgbConfig, render_ground_truth, render_rgb
-from dataset.scenes.images import write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import write_transforms
+from envelope.camera import Intrinsics, look_at
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import write_depth_m, write_labels, write_rgb
+from envelope.scenes.scene import write_transforms
+from envelope.truth import Building
 
 
 def write_ring_scene(building: Building, root: Path, *, size_px: int = 40, n_train: int = 24,

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 
 
 def box_sdf(points_m: np.ndarray, box_min_m, box_max_m) -> np.ndarray:
@@ -60,7 +60,7 @@ def truth_mesh_of(tm, *, curved: bool = False):
     Faces facing up are roof, down background, both facade 0; sides are wall. Side faces
     with the same azimuth (to 1 degree) share an id; ``curved=True`` gives every side face id 1.
     """
-    from dataset.core.mesh import LabelledMesh
+    from envelope.mesh import LabelledMesh
 
     n = tm.face_normals
     label = np.full(len(n), int(SemanticClass.WALL), dtype=np.uint8)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 
 SIGMA_PER_LEVEL = 0.01  # noise std as a fraction of the depth, per severity level
 GLASS_HOLE_P_PER_LEVEL = 0.25  # probability that a window pixel has no depth, per level

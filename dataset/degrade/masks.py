@@ -9,7 +9,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 
 WINDOW = int(SemanticClass.WINDOW)
 WALL = int(SemanticClass.WALL)

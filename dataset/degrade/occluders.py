@@ -12,10 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, rays_world
-from dataset.core.classes import FACADE_CLASSES, SemanticClass
-from dataset.core.mesh import LabelledMesh
 from dataset.rendering.render import Raycaster
+from envelope.camera import Intrinsics, rays_world
+from envelope.classes import FACADE_CLASSES, SemanticClass
+from envelope.mesh import LabelledMesh
 
 DISTANCE_M = (1.5, 5.0)  # occluder centre in front of the facade plane
 CAMERA_CLEARANCE_M = 0.5  # no camera may sit inside an occluder grown by this
@@ -81,7 +81,7 @@ def render_occluders(
     """Draw occluders into one view's images (new arrays): (rgb, depth, labels, normals).
 
     A pixel shows an occluder where the occluder's z-depth is smaller than the
-    scene's (or the scene has none there). Shapes as in :mod:`dataset.scenes.images`.
+    scene's (or the scene has none there). Shapes as in :mod:`envelope.scenes.images`.
     """
     rc = Raycaster(occluders.mesh)
     origins, dirs = rays_world(intrinsics, world_from_camera)

@@ -19,9 +19,6 @@ from typing import Any
 
 import numpy as np
 
-from dataset.core.atomic import atomic_directory
-from dataset.core.mesh import read_labelled_ply
-from dataset.core.scene_record import Frame, Scene
 from dataset.degrade.depth_noise import noisy_depth_m
 from dataset.degrade.masks import (
     bleed_labels,
@@ -34,7 +31,10 @@ from dataset.degrade.masks import (
 from dataset.degrade.occluders import place_occluders, render_occluders
 from dataset.degrade.poses import pose_noise
 from dataset.degrade.spec import DegradeSpec
-from dataset.scenes.images import (
+from envelope.atomic import atomic_directory
+from envelope.mesh import read_labelled_ply
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import (
     read_depth_m,
     read_labels,
     read_normals,
@@ -44,7 +44,7 @@ from dataset.scenes.images import (
     write_normals,
     write_rgb,
 )
-from dataset.scenes.scene import read_scene, write_transforms
+from envelope.scenes.scene import read_scene, write_transforms
 
 RECORD_KEY = "degradation"
 _MASK_FNS = {

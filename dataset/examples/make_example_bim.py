@@ -17,9 +17,9 @@ from typing import Literal
 
 import numpy as np
 
-from dataset.core.atomic import write_text_atomic
-from dataset.core.classes import CLASS_NAMES, NO_FACADE, SemanticClass
-from dataset.core.mesh import LabelledMesh, write_labelled_ply
+from envelope.atomic import write_text_atomic
+from envelope.classes import CLASS_NAMES, NO_FACADE, SemanticClass
+from envelope.mesh import LabelledMesh, write_labelled_ply
 
 Box = tuple[tuple[float, float, float], tuple[float, float, float], SemanticClass]
 """(min corner, max corner, class) of a solid box, metres."""

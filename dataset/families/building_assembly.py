@@ -1,4 +1,4 @@
-"""Walls + other faces -> :class:`dataset.core.truth.Building` with analytic ground truth.
+"""Walls + other faces -> :class:`envelope.truth.Building` with analytic ground truth.
 
 Per-facade truth is summed from each wall's parameters (outline area, opening
 sizes, contact rectangles), never from the triangulated mesh, so that tests can
@@ -15,14 +15,14 @@ from typing import Any
 import numpy as np
 from shapely.geometry import Polygon
 
-from dataset.core.classes import SemanticClass
-from dataset.core.footprint import polygon_to_geojson
-from dataset.core.mesh import MERGE_DECIMALS, LabelledMesh
-from dataset.core.truth import Building, BuildingTruth, BuildingType, FacadeTruth
-from dataset.core.wwr import ClassAreas
 from dataset.families.facade_geometry import WallSpec, wall_faces
 from dataset.families.polygon_mesh import PlanarFace, triangulate_faces
 from dataset.families.visible_facade import hidden_facade_areas_m2
+from envelope.classes import SemanticClass
+from envelope.footprint import polygon_to_geojson
+from envelope.mesh import MERGE_DECIMALS, LabelledMesh
+from envelope.truth import Building, BuildingTruth, BuildingType, FacadeTruth
+from envelope.wwr import ClassAreas
 
 HIDDEN_NOISE_M2 = 1e-6
 """A hidden area below this (1 cm x 0.1 mm) is round-off of the polygon operations, not a

@@ -18,8 +18,8 @@ from typing import Literal
 import numpy as np
 from shapely.geometry import Polygon, box
 
-from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.families.polygon_mesh import PlanarFace
+from envelope.classes import NO_FACADE, SemanticClass
 
 MIN_GAP_M = 0.05
 """Smallest distance between two openings, or an opening and the wall edge: holes must not

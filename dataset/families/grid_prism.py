@@ -14,11 +14,11 @@ from typing import Any, Literal
 
 import numpy as np
 
-from dataset.core.truth import Building, BuildingType
-from dataset.core.wwr import ClassAreas
 from dataset.families.building_assembly import assemble_building, facade_truths
 from dataset.families.facade_geometry import Opening, WallSpec, drop_near, window_grid
 from dataset.families.prism import ground_face, overhang_roof_faces, parapet_roof_faces, prism_walls
+from envelope.truth import Building, BuildingType
+from envelope.wwr import ClassAreas
 
 RoofKind = Literal["parapet", "overhang"]
 

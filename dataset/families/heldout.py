@@ -13,7 +13,6 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
-from dataset.core.truth import Building
 from dataset.families.building_assembly import BuildingLayout, assemble_layout
 from dataset.families.heldout_params import HeldoutModel, HeldoutParams, default_heldout_params
 from dataset.families.heldout_plan import bow_layout, corner_layout, sawtooth_layout
@@ -21,6 +20,7 @@ from dataset.families.heldout_recess import loggia_layout
 from dataset.families.heldout_roofs import hip_layout, mansard_layout
 from dataset.families.heldout_setback import setback_layout
 from dataset.families.heldout_slope import slope_layout
+from envelope.truth import Building
 
 _LAYOUTS = {
     "hip": hip_layout, "mansard": mansard_layout, "setback": setback_layout,

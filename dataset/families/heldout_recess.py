@@ -23,7 +23,6 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import Polygon
 
-from dataset.core.classes import SemanticClass
 from dataset.families.building_assembly import BuildingLayout
 from dataset.families.facade_geometry import MIN_GAP_M, Opening, WallFrame, WallSpec
 from dataset.families.heldout_openings import (
@@ -35,6 +34,7 @@ from dataset.families.heldout_openings import (
 from dataset.families.heldout_params import HeldoutParams
 from dataset.families.polygon_mesh import PlanarFace, extruded_faces
 from dataset.families.prism import edge_frames, ground_face, parapet_roof_faces
+from envelope.classes import SemanticClass
 
 PARAPET_THICKNESS_M = 0.3
 CEILING_BELOW_FLOOR_M = 0.35  # a recess's ceiling stays this far under the next floor

@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import SemanticClass
 from dataset.families.building_assembly import BuildingLayout
 from dataset.families.heldout_openings import rectangle_footprint, wall_openings
 from dataset.families.heldout_params import HeldoutParams
 from dataset.families.polygon_mesh import PlanarFace, vertical_quad
 from dataset.families.prism import UP, ground_face, prism_walls
+from envelope.classes import SemanticClass
 
 HIP_OVERHANG_M = 0.5
 SHELL_THICKNESS_M = 0.2

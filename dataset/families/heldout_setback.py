@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import SemanticClass
 from dataset.families.building_assembly import BuildingLayout
 from dataset.families.facade_geometry import WallSpec
 from dataset.families.heldout_openings import rectangle_footprint, wall_openings
 from dataset.families.heldout_params import HeldoutParams
 from dataset.families.polygon_mesh import PlanarFace
 from dataset.families.prism import UP, edge_frames, ground_face, parapet_roof_faces
+from envelope.classes import SemanticClass
 
 PARAPET_THICKNESS_M = 0.3
 TIERS = 3

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import SemanticClass
 from dataset.families.building_assembly import BuildingLayout
 from dataset.families.facade_geometry import WallSpec, window_grid
 from dataset.families.heldout_openings import (
@@ -33,6 +32,7 @@ from dataset.families.heldout_openings import (
 from dataset.families.heldout_params import HeldoutParams
 from dataset.families.polygon_mesh import PlanarFace
 from dataset.families.prism import edge_frames, parapet_roof_faces
+from envelope.classes import SemanticClass
 
 PARAPET_THICKNESS_M = 0.3
 BASEMENT_SILL_M = 0.3

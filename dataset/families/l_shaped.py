@@ -15,7 +15,6 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from dataset.core.truth import Building
 from dataset.families.facade_geometry import WallSpec
 from dataset.families.grid_prism import (
     RoofSpec,
@@ -24,6 +23,7 @@ from dataset.families.grid_prism import (
     grid_prism_walls,
     grid_prism_wwr,
 )
+from envelope.truth import Building
 
 FLOORS_RANGE = (4, 6)
 HEIGHT_RANGE_M = (10.0, 14.0)

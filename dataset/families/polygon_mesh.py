@@ -17,8 +17,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from dataset.core.classes import NO_FACADE, NUM_CLASSES
-from dataset.core.mesh import MERGE_DECIMALS, LabelledMesh
+from envelope.classes import NO_FACADE, NUM_CLASSES
+from envelope.mesh import MERGE_DECIMALS, LabelledMesh
 
 COLLINEAR_TOL_M = 1e-7
 """A vertex closer than this to a triangle edge lies on it (earcut leaves such T-junctions and
@@ -39,9 +39,9 @@ class PlanarFace:
     normal : (3,) float64
         Outward unit normal (the side the surface faces, away from the solid).
     label : int
-        Semantic class id (:class:`dataset.core.classes.SemanticClass`).
+        Semantic class id (:class:`envelope.classes.SemanticClass`).
     facade_id : int
-        Facade id from 1, or :data:`dataset.core.classes.NO_FACADE` (0).
+        Facade id from 1, or :data:`envelope.classes.NO_FACADE` (0).
     """
 
     rings_m: tuple[np.ndarray, ...]

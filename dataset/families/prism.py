@@ -18,9 +18,9 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from dataset.core.classes import SemanticClass
 from dataset.families.facade_geometry import Opening, WallFrame, WallSpec, rectangle_outline
 from dataset.families.polygon_mesh import PlanarFace, swept_faces, vertical_quad
+from envelope.classes import SemanticClass
 
 UP = np.array([0.0, 0.0, 1.0])
 DOWN = np.array([0.0, 0.0, -1.0])

@@ -18,7 +18,6 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
-from dataset.core.truth import Building
 from dataset.families.building_assembly import BuildingLayout, assemble_layout
 from dataset.families.realistic_balcony import balcony_layout
 from dataset.families.realistic_house import house_layout
@@ -28,6 +27,7 @@ from dataset.families.realistic_params import (
     default_realistic_params,
 )
 from dataset.families.realistic_rounded import rounded_layout
+from envelope.truth import Building
 
 FLOORS_RANGE = (2, 7)
 HEIGHT_RANGE_M = (14.0, 25.0)

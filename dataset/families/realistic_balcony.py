@@ -21,12 +21,12 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import Polygon
 
-from dataset.core.classes import SemanticClass
 from dataset.families.building_assembly import BuildingLayout
 from dataset.families.facade_geometry import Opening, WallFrame
 from dataset.families.polygon_mesh import PlanarFace, extruded_faces
 from dataset.families.prism import edge_frames, ground_face, parapet_roof_faces, prism_walls
 from dataset.families.realistic_params import RealisticParams
+from envelope.classes import SemanticClass
 
 SLAB_THICKNESS_M = 0.2
 RAILING_GAP_M = 0.01

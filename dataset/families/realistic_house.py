@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 from shapely.geometry import box
 
-from dataset.core.classes import SemanticClass
 from dataset.families.building_assembly import BuildingLayout
 from dataset.families.facade_geometry import Opening, drop_near, window_grid
 from dataset.families.polygon_mesh import extruded_faces
@@ -26,6 +25,7 @@ from dataset.families.prism import (
     ground_face,
 )
 from dataset.families.realistic_params import RealisticParams
+from envelope.classes import SemanticClass
 
 DOOR_WIDTH_M = 1.1
 DOOR_HEIGHT_M = 2.2

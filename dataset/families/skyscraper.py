@@ -10,7 +10,6 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from dataset.core.truth import Building
 from dataset.families.facade_geometry import WallSpec
 from dataset.families.grid_prism import (
     RoofSpec,
@@ -19,6 +18,7 @@ from dataset.families.grid_prism import (
     grid_prism_walls,
     grid_prism_wwr,
 )
+from envelope.truth import Building
 
 # Ranges of the family (issue 2). 22 storeys of >= 2.7 m cannot stay below 46 m, so the
 # sampler caps the storey count by the height range (see docs/buildings.md).

@@ -21,8 +21,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from dataset.core.classes import FACADE_CLASSES, NO_FACADE
-from dataset.core.mesh import LabelledMesh, plane_bases
+from envelope.classes import FACADE_CLASSES, NO_FACADE
+from envelope.mesh import LabelledMesh, plane_bases
 
 IN_FRONT_TOL_M = 1e-6
 """A point this far or less in front of a facade plane lies on it (the mesh merges vertices

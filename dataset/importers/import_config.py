@@ -1,5 +1,5 @@
 """How a labelled mesh becomes a building: :class:`ImportConfig`, one place for the import
-options of the mesh and IFC sources (:mod:`dataset.importers.building_file`).
+options of the mesh and IFC sources (:mod:`dataset.importers.mesh.building_file`).
 
 ``python -m dataset.generate --mesh/--ifc`` and ``python -m dataset.importer`` offer every
 field as an option (``--ground-z``, ``--footprint-height-m``, ...; :mod:`dataset.source_args`).
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from dataset.importers.mesh_files import UpAxis
-from dataset.rendering.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
+from dataset.importers.mesh.mesh_files import UpAxis
+from envelope.geometry.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
 
 
 @dataclass(frozen=True)

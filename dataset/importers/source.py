@@ -12,8 +12,9 @@ either
   project scene folder by :func:`write_scenes` (the BuildNet3D layouts).
 
 The one list of sources is :data:`dataset.sources.SOURCES`; the sources are declared beside
-their readers (:mod:`dataset.importers.building_file`, :mod:`dataset.importers.buildnet3d`,
-:mod:`dataset.importers.blenderproc`, :mod:`dataset.sources` for the presets). A source
+their readers (:mod:`dataset.importers.mesh.building_file`,
+:mod:`dataset.importers.buildnet3d.buildnet3d`,
+:mod:`dataset.importers.buildnet3d.blenderproc`, :mod:`dataset.sources` for the presets). A source
 reads no command line: its options are a typed frozen dataclass, which
 :mod:`dataset.source_args` builds from the command line once.
 """
@@ -27,8 +28,8 @@ from typing import Any
 
 from tqdm import tqdm
 
-from dataset.core.atomic import atomic_directory
-from dataset.core.truth import Building
+from envelope.atomic import atomic_directory
+from envelope.truth import Building
 
 
 @dataclass(frozen=True)
@@ -111,7 +112,7 @@ def write_scenes(entries: Sequence[SceneEntry], out_root: str | Path, *,
     """Write every scene entry into ``out_root / entry.name``; return the scene folders.
 
     Each scene is written into a temporary sibling and renamed when finished
-    (:func:`dataset.core.atomic.atomic_directory`), so a folder with the final name is
+    (:func:`envelope.atomic.atomic_directory`), so a folder with the final name is
     always complete. An existing scene is kept unless ``overwrite``.
     """
     out_root = Path(out_root)

@@ -1,5 +1,5 @@
 """What a building's views are rendered from: the building, its textures and, with
-``--context``, its neighbours (:class:`dataset.core.neighbours.Neighbour`) as occluders.
+``--context``, its neighbours (:class:`envelope.neighbours.Neighbour`) as occluders.
 
 Neighbours are rendered as what a camera in the street sees: their surfaces hide the
 building, cast shadows and show their own textures and colours, and in the label images
@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.appearance import concatenate_appearances
-from dataset.core.classes import NO_FACADE, SemanticClass
-from dataset.core.mesh import LabelledMesh
-from dataset.core.truth import Building
-from dataset.rendering.raycast import Raycaster
 from dataset.rendering.textures import TextureSet, prepare_textures
+from envelope.appearance import concatenate_appearances
+from envelope.classes import NO_FACADE, SemanticClass
+from envelope.geometry.raycast import Raycaster
+from envelope.mesh import LabelledMesh
+from envelope.truth import Building
 
 CLEARANCE_M = 0.5
 """A moved camera stands this far in front of the neighbour surface that blocked it."""

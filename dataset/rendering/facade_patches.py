@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.classes import NO_FACADE
-from dataset.core.truth import Building
+from envelope.classes import NO_FACADE
+from envelope.truth import Building
 
 _UP = np.array([0.0, 0.0, 1.0])
 # A facade normal needs at least this much horizontal length to define a wall

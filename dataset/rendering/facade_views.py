@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, look_at, project_world_to_image
-from dataset.core.truth import Building
 from dataset.rendering.facade_patches import FacadePatch, facade_patches
 from dataset.rendering.render import Raycaster
+from envelope.camera import Intrinsics, look_at, project_world_to_image
+from envelope.truth import Building
 
 
 @dataclass(frozen=True)

@@ -21,9 +21,9 @@ from typing import Literal
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.truth import Building
 from dataset.rendering.render import Raycaster, render_ground_truth
+from envelope.camera import Intrinsics, look_at
+from envelope.truth import Building
 
 ViewFailure = Literal[
     "below_ground", "inside_building", "under_building", "too_close", "not_visible",

@@ -18,11 +18,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.camera import Intrinsics, rays_world
-from dataset.core.mesh import LabelledMesh
-from dataset.rendering.raycast import Raycaster
 from dataset.rendering.shading import RgbConfig, shade
 from dataset.rendering.textures import TextureSet
+from envelope.camera import Intrinsics, rays_world
+from envelope.geometry.raycast import Raycaster
+from envelope.mesh import LabelledMesh
 
 GROUND_Z_M = 0.0
 GROUND_TOLERANCE_M = 1e-6  # hits this far below the ground still count (float round-off)
@@ -48,7 +48,7 @@ class GroundTruthImages:
     normals_world : (H, W, 3) float32
         Unit outward face normals in the world frame, zero where no surface.
     labels : (H, W) uint8
-        Semantic class ids (:class:`dataset.core.classes.SemanticClass`), 0 = background.
+        Semantic class ids (:class:`envelope.classes.SemanticClass`), 0 = background.
     facade_ids : (H, W) int32
         Facade id of the hit face, 0 = none.
     """
@@ -163,7 +163,7 @@ def _cast_view(
     rc = mesh if isinstance(mesh, Raycaster) else Raycaster(mesh)
     if not isinstance(intrinsics, Intrinsics):
         raise ValueError(
-            f"intrinsics must be a dataset.core.camera.Intrinsics, got {type(intrinsics)}")
+            f"intrinsics must be a envelope.camera.Intrinsics, got {type(intrinsics)}")
     pose = np.asarray(world_from_camera, dtype=np.float64)
     if pose.shape != (4, 4) or not np.isfinite(pose).all():
         raise ValueError(

@@ -2,7 +2,7 @@
 
 The section's segments are snapped to :data:`SNAP_GRID_M` and polygonised; each face of
 that planar arrangement is solid if a point inside it is inside the building (the one
-inside rule, :meth:`dataset.rendering.raycast.Raycaster.contains`: the union of the mesh's bodies).
+inside rule, :meth:`envelope.geometry.raycast.Raycaster.contains`: the union of the mesh's bodies).
 The footprint is the solid's outline: every hole in the solid is filled (rooms between
 exterior and interior walls of a BIM model, the insides of partitions) unless it is open
 to the sky -- a vertical ray from it leaves the mesh -- which makes it a courtyard, kept
@@ -16,7 +16,7 @@ import shapely
 from shapely.geometry import MultiLineString, MultiPolygon, Polygon
 from shapely.ops import polygonize, unary_union
 
-from dataset.rendering.raycast import Raycaster
+from envelope.geometry.raycast import Raycaster
 
 SNAP_GRID_M = 1e-6  # joins segment ends that float round-off left a few nm apart
 

@@ -18,11 +18,11 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
-from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.rendering.textures import TextureSet, texture_albedo
+from envelope.classes import NO_FACADE, SemanticClass
 
 if TYPE_CHECKING:
-    from dataset.rendering.raycast import Raycaster
+    from envelope.geometry.raycast import Raycaster
 
 WallMaterial = Literal["random", "plaster", "brick"]
 
@@ -186,7 +186,7 @@ def shade(
     origins_m, dirs : (N, 3) float
         The rays (``dirs`` any length; hit point = origin + t * dir).
     face : (N,) int, t : (N,) float
-        First hits as returned by :meth:`dataset.rendering.raycast.Raycaster.first_hit`.
+        First hits as returned by :meth:`envelope.geometry.raycast.Raycaster.first_hit`.
     """
     look = sample_look(seed, config)
     d_unit = dirs / np.linalg.norm(dirs, axis=1, keepdims=True)

@@ -2,7 +2,7 @@
 from the road (``--street``, the ``street`` split), placed without the truth.
 
 **Where the car drives.** Along the building's streets (``Building.streets``: the lanes of the
-source's road network, :mod:`dataset.importers.opendrive_streets`); a source without a road
+source's road network, :mod:`dataset.importers.opendrive.streets`); a source without a road
 network gets a stand-in (:func:`street_paths`): a path :attr:`StreetConfig.fallback_offset_m`
 outside the block the building stands in (the x/y convex hulls of the building and of its
 neighbours, those closer than :attr:`StreetConfig.block_gap_m` joined into one block), as a
@@ -38,10 +38,10 @@ import shapely
 from shapely.geometry import MultiPoint
 from shapely.geometry.polygon import orient
 
-from dataset.core.camera import Intrinsics, rays_world
-from dataset.core.mesh import LabelledMesh
-from dataset.core.truth import Building
-from dataset.rendering.raycast import Raycaster
+from envelope.camera import Intrinsics, rays_world
+from envelope.geometry.raycast import Raycaster
+from envelope.mesh import LabelledMesh
+from envelope.truth import Building
 
 STREET_FRAMES_PER_BUILDING = 100
 """Street frames assumed per building before it is planned (disk and memory estimates); the

@@ -1,5 +1,5 @@
 """Surface textures and material colours in the RGB render (a source's
-:class:`dataset.core.appearance.SurfaceAppearance`).
+:class:`envelope.appearance.SurfaceAppearance`).
 
 :func:`prepare_textures` turns each image into a mip pyramid of linear albedo once per
 scene; :func:`texture_albedo` samples it at hit points: texture coordinates from the face's
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.appearance import SurfaceAppearance
+from envelope.appearance import SurfaceAppearance
 
 SRGB_GAMMA = 2.2  # sRGB texel -> linear albedo, as the procedural palettes (shading.py)
 

@@ -6,7 +6,7 @@ takes from the road), each with RGB, z-depth, semantics,
 normals and facade ids (``instances/``: ground truth for tests and evaluation
 only), plus ``transforms.json``, ``building.json`` and ``mesh.ply``. It is
 written into a hidden temporary folder and renamed into place when complete
-(:func:`dataset.core.atomic.atomic_directory`), so a folder with the final name is
+(:func:`envelope.atomic.atomic_directory`), so a folder with the final name is
 always finished. ``transforms.json`` records the config and seed under
 ``generator``, which is how a rerun recognises a finished scene.
 """
@@ -21,10 +21,17 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
-from dataset.core.atomic import atomic_directory
-from dataset.core.camera import Intrinsics
-from dataset.core.mesh import write_labelled_ply
-from dataset.core.protocols import (
+from dataset.rendering.context import ViewMeshes
+from dataset.rendering.facade_views import FacadeViewConfig, ideal_views, multi_views
+from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views
+from dataset.rendering.render import Raycaster, render_view
+from dataset.rendering.shading import RgbConfig
+from dataset.rendering.street_views import StreetConfig, street_views
+from envelope.atomic import atomic_directory
+from envelope.camera import Intrinsics
+from envelope.executors.worker_pool import worker_pool
+from envelope.mesh import write_labelled_ply
+from envelope.protocols import (
     EVAL_SPLIT,
     IDEAL_PROTOCOL,
     MULTI_PROTOCOL,
@@ -32,23 +39,15 @@ from dataset.core.protocols import (
     TRAIN_PROTOCOL,
     Split,
 )
-from dataset.core.provenance import (
+from envelope.provenance import (
     Provenance,
     ProvenanceChange,
     code_version,
     make_provenance,
     provenance_changes,
 )
-from dataset.core.scene_record import Frame, Scene
-from dataset.core.truth import Building, write_building
-from dataset.executors.worker_pool import worker_pool
-from dataset.rendering.context import ViewMeshes
-from dataset.rendering.facade_views import FacadeViewConfig, ideal_views, multi_views
-from dataset.rendering.orbit_views import OrbitConfig, sample_orbit_views
-from dataset.rendering.render import Raycaster, render_view
-from dataset.rendering.shading import RgbConfig
-from dataset.rendering.street_views import StreetConfig, street_views
-from dataset.scenes.images import (
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import (
     DEPTH_MAX_UNITS,
     write_depth_m,
     write_facade_ids,
@@ -56,9 +55,10 @@ from dataset.scenes.images import (
     write_normals,
     write_rgb,
 )
-from dataset.scenes.scene import write_transforms
+from envelope.scenes.scene import write_transforms
+from envelope.truth import Building, write_building
 
-SCENE_CODE = ("dataset",)  # a scene depends on the whole dataset package's code
+SCENE_CODE = ("dataset", "envelope")  # a scene depends on the code that makes and writes it
 SCENE_LIBRARIES = ("numpy", "embreex", "trimesh", "scipy", "shapely", "pillow",
                    "opencv-contrib-python-headless", "mapbox-earcut")
 _POOL_CHUNK = 8  # views per task: few enough for a smooth progress bar, enough to amortise
@@ -230,7 +230,7 @@ def generator_record(
     config: GenerateConfig, seed: int, inputs: dict[str, Any] | None = None
 ) -> dict[str, Any]:
     """What ``transforms.json`` records under ``generator``: config, seed, code version and
-    the scene's :class:`~dataset.core.provenance.Provenance` (``inputs``: what the building was
+    the scene's :class:`~envelope.provenance.Provenance` (``inputs``: what the building was
     made from, e.g. ``{"preset": "tiny", "recipe": "tiny_l_shaped"}`` or a mesh file's
     fingerprint; the seed is added)."""
     record = scene_provenance(config, seed, inputs)

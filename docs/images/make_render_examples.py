@@ -16,10 +16,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from dataset.core.camera import Intrinsics, look_at  # noqa: E402
 from dataset.presets import build_building, preset_recipes  # noqa: E402
 from dataset.rendering.orbit_views import point_of_interest_m  # noqa: E402
 from dataset.rendering.render import Raycaster, render_view  # noqa: E402
+from envelope.camera import Intrinsics, look_at  # noqa: E402
 
 # background, wall, window, roof, door, other (RGB)
 PALETTE = np.array([[0, 0, 0], [190, 190, 190], [40, 120, 230], [200, 60, 50],

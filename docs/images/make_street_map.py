@@ -2,7 +2,7 @@
 
 Every shipped CityGML file's ground surfaces (grey; the 49 scene buildings darker) and the
 OpenDRIVE lanes (driving lanes blue, sidewalks green), both in EPSG:32632 metres as
-:mod:`dataset.importers.opendrive_streets` maps them (offset zero), with one building's
+:mod:`dataset.importers.opendrive.streets` maps them (offset zero), with one building's
 street cameras (red, ``--street`` defaults) to check that the roads run between the houses.
 Writes ``docs/images/street_map.png``.
 """
@@ -21,15 +21,15 @@ import numpy as np  # noqa: E402
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from dataset.importers.citygml_preset import (  # noqa: E402
+from dataset.importers.citygml.preset import (  # noqa: E402
     LOD3_DIR,
     ROAD_NETWORK,
     build_lod3_building,
     lod3_entries,
     lod3_files,
 )
-from dataset.importers.citygml_read import read_citygml  # noqa: E402
-from dataset.importers.opendrive_streets import streets_in_frame  # noqa: E402
+from dataset.importers.citygml.read import read_citygml  # noqa: E402
+from dataset.importers.opendrive.streets import streets_in_frame  # noqa: E402
 from dataset.rendering.street_views import StreetConfig, street_stations  # noqa: E402
 
 EXAMPLE = "4018106"  # the building whose cameras are drawn

@@ -35,9 +35,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dataset.core.classes import NUM_CLASSES
-from dataset.core.mesh import triangle_areas_m2, triangle_normals
-from dataset.rendering.raycast import Raycaster
+from envelope.classes import NUM_CLASSES
+from envelope.geometry.raycast import Raycaster
+from envelope.mesh import triangle_areas_m2, triangle_normals
 from neural3d.extraction.facade_planes import FacadePlanes, plane_frame
 from neural3d.extraction.occluded_facade import PlaneProbe
 

@@ -2,7 +2,7 @@
 
 Kept apart from :mod:`neural3d.extract` (which needs torch) so that a
 comparison can state and check the extraction settings without loading a
-field (``metrics.methods``).
+field (``metrics.run.methods``).
 """
 
 from __future__ import annotations

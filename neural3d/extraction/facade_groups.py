@@ -26,8 +26,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
-from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES
-from dataset.core.mesh import triangle_areas_m2, triangle_normals
+from envelope.classes import FACADE_CLASSES, NUM_CLASSES
+from envelope.mesh import triangle_areas_m2, triangle_normals
 from neural3d.extraction.facade_planes import azimuth_offset, circular_mean_deg, wrap_deg
 from neural3d.extraction.measure_config import MeasureConfig
 

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.mesh import triangle_normals
+from envelope.mesh import triangle_normals
 from neural3d.extraction.measure_config import MeasureConfig
 
 

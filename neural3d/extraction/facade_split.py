@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES
+from envelope.classes import FACADE_CLASSES, NUM_CLASSES
 
 
 def split_facade_area_by_probability(
@@ -31,7 +31,7 @@ def split_facade_area_by_probability(
         corners' labels (m²)
     faces : (F, 3) int vertex indices
     vertex_probabilities : (V, NUM_CLASSES) class probabilities (>= 0) of every vertex,
-        in :mod:`dataset.core.classes` id order
+        in :mod:`envelope.classes` id order
 
     Returns
     -------

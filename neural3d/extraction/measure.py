@@ -12,7 +12,7 @@
 - without, every triangle counts its classes with its full area (the paper), and
   the per-facade figures are the groups' (none without ``grouping``).
 
-Gross facade = wall + window + door (:class:`dataset.core.wwr.ClassAreas`); roof,
+Gross facade = wall + window + door (:class:`envelope.wwr.ClassAreas`); roof,
 other and background never count.
 """
 
@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
-from dataset.core.mesh import triangle_normals
-from dataset.core.wwr import ClassAreas
+from envelope.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
+from envelope.mesh import triangle_normals
+from envelope.wwr import ClassAreas
 from neural3d.extraction.facade_planes import azimuth_offset
 from neural3d.extraction.measure_config import MeasureConfig
 from neural3d.extraction.measure_stages import (
@@ -97,7 +97,7 @@ def measure_semantic_mesh(
     ----------
     vertices_m : (V, 3) float, world metres (z up, ground at z = 0)
     faces : (F, 3) int, outward-oriented
-    vertex_labels : (V,) int class ids (:mod:`dataset.core.classes`)
+    vertex_labels : (V,) int class ids (:mod:`envelope.classes`)
     config : which stages run and their settings
     vertex_probabilities : optional (V, NUM_CLASSES) class probabilities, read by the
         ``probability_split`` stage

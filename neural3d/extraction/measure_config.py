@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields, replace
 
-from dataset.rendering.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
+from envelope.geometry.visibility import MIN_ESCAPE_FRACTION, RAY_OFFSET_M
 
 # stage -> the stage whose output it reads (a stage runs only with the one it needs)
 STAGE_NEEDS = {
@@ -69,7 +69,7 @@ class MeasureConfig:
     """
 
     stages: MeasureStages = field(default_factory=MeasureStages)
-    # visibility_cull (dataset.rendering.visibility): 4 points x this many rays per face
+    # visibility_cull (envelope.geometry.visibility): 4 points x this many rays per face
     visibility_rays_per_sample: int = 4
     min_escape_fraction: float = MIN_ESCAPE_FRACTION
     ray_offset_m: float = RAY_OFFSET_M

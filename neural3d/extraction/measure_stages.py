@@ -17,9 +17,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES
-from dataset.rendering.raycast import Raycaster
-from dataset.rendering.visibility import seen_from_outside
+from envelope.classes import FACADE_CLASSES, NUM_CLASSES
+from envelope.geometry.raycast import Raycaster
+from envelope.geometry.visibility import seen_from_outside
 from neural3d.extraction.concave_corners import concave_corner_fill
 from neural3d.extraction.facade_groups import check_mesh_inputs, class_area_m2, group_faces
 from neural3d.extraction.facade_planes import FacadePlanes, project_onto_facade_planes
@@ -108,7 +108,7 @@ def split_by_probability(state: MeasureState, config: MeasureConfig) -> MeasureS
 
 def cull_hidden_faces(state: MeasureState, config: MeasureConfig) -> MeasureState:
     """Facade triangles no ray leaves count for nothing
-    (:func:`dataset.rendering.visibility.seen_from_outside`: ``visibility_rays_per_sample``
+    (:func:`envelope.geometry.visibility.seen_from_outside`: ``visibility_rays_per_sample``
     rays from 4 points of each face, at least ``min_escape_fraction`` must escape; the
     ground, the plane z = 0 within the mesh's x/y box, stops a downward ray that meets it
     there, so the inner sides of walls over an open underside see nothing, while the wall

@@ -1,11 +1,11 @@
 """Marching-cubes mesh of a signed distance function, per-vertex semantics and colour.
 
-The mesh is written with :func:`dataset.core.semantic_ply.write_semantic_ply`.
+The mesh is written with :func:`envelope.semantic_ply.write_semantic_ply`.
 
 The core works on plain NumPy callables so it does not depend on torch:
 
 - ``SdfFn``: (N, 3) world metres -> (N,) signed distance in m, positive outside;
-- ``LabelFn``: (N, 3) world metres -> (N,) int class ids (:mod:`dataset.core.classes`);
+- ``LabelFn``: (N, 3) world metres -> (N,) int class ids (:mod:`envelope.classes`);
 - ``ColorFn``: (N, 3) world metres, (N, 3) unit view directions -> (N, 3) float in [0, 1].
 
 The grid is evaluated in groups of x slabs of about ``chunk_points`` points into
@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 from tqdm import tqdm
 
-from dataset.core.classes import NUM_CLASSES
-from dataset.core.mesh import triangle_areas_m2
-from dataset.core.semantic_ply import check_mesh_arrays, check_points_m
+from envelope.classes import NUM_CLASSES
+from envelope.mesh import triangle_areas_m2
+from envelope.semantic_ply import check_mesh_arrays, check_points_m
 from neural3d.field.chunks import DEFAULT_CHUNK_POINTS
 
 SdfFn = Callable[[np.ndarray], np.ndarray]
@@ -45,7 +45,7 @@ class SemanticMesh:
     vertex_labels : (V,) uint8 class ids
     vertex_rgb : (V, 3) uint8
     vertex_probabilities : (V, NUM_CLASSES) float32 class probabilities in
-        :mod:`dataset.core.classes` id order (``vertex_labels`` is their argmax)
+        :mod:`envelope.classes` id order (``vertex_labels`` is their argmax)
     """
 
     vertices_m: np.ndarray

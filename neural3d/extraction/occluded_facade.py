@@ -38,8 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES
-from dataset.rendering.raycast import Raycaster
+from envelope.classes import FACADE_CLASSES, NUM_CLASSES
+from envelope.geometry.raycast import Raycaster
 from neural3d.extraction.facade_planes import FacadePlanes, plane_frame
 
 FACADE_IDS = tuple(int(c) for c in FACADE_CLASSES)

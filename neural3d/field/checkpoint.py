@@ -15,7 +15,7 @@ from typing import Any
 
 import torch
 
-from dataset.core.atomic import write_bytes_atomic
+from envelope.atomic import write_bytes_atomic
 
 CHECKPOINT_NAME = "checkpoint.pt"
 SNAPSHOT_FOLDER = "snapshots"

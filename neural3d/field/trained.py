@@ -9,8 +9,8 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from dataset.core.device import resolve_device
-from dataset.core.scene_record import scene_name
+from envelope.device import resolve_device
+from envelope.scene_record import scene_name
 from neural3d.config import FieldConfig, config_from_dict
 from neural3d.field.checkpoint import read_checkpoint, snapshot_path, snapshot_steps
 from neural3d.field.chunks import DEFAULT_CHUNK_POINTS

@@ -13,12 +13,12 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from dataset.core.camera import Intrinsics, rays_world
-from dataset.core.classes import SemanticClass
-from dataset.core.method_input import MethodInput
-from dataset.core.protocols import Split
-from dataset.scenes.images import read_rgb
-from dataset.scenes.scene_validation import read_frame_depth_m, read_frame_labels
+from envelope.camera import Intrinsics, rays_world
+from envelope.classes import SemanticClass
+from envelope.method_input import MethodInput
+from envelope.protocols import Split
+from envelope.scenes.images import read_rgb
+from envelope.scenes.scene_validation import read_frame_depth_m, read_frame_labels
 from neural3d.field.normalisation import Normalisation
 from neural3d.training.scene_box import visual_hull_box_m
 
@@ -59,8 +59,8 @@ class Pixels:
 
 
 def background_class(scene: MethodInput) -> int:
-    """Our background class id: :func:`dataset.scenes.scene_validation.read_frame_labels` gives
-    every frame's labels in the project's ids (:data:`dataset.core.classes.CLASS_NAMES`), whatever
+    """Our background class id: :func:`envelope.scenes.scene_validation.read_frame_labels` gives
+    every frame's labels in the project's ids (:data:`envelope.classes.CLASS_NAMES`), whatever
     the scene holds."""
     return int(SemanticClass.BACKGROUND)
 

@@ -15,20 +15,20 @@ from typing import Literal
 
 import torch
 
-from dataset.core.atomic import write_json_atomic, write_text_atomic
-from dataset.core.provenance import (
+from envelope.atomic import write_json_atomic, write_text_atomic
+from envelope.provenance import (
     Provenance,
     file_fingerprint,
     make_provenance,
     provenance_changes,
 )
-from dataset.core.results import code_version
-from dataset.core.scene_record import scene_name
+from envelope.results import code_version
+from envelope.scene_record import scene_name
 from neural3d.config import TrainConfig, config_from_dict, config_to_dict
 from neural3d.field.checkpoint import CHECKPOINT_NAME, SNAPSHOT_FOLDER, read_checkpoint
 from neural3d.field.normalisation import Normalisation
 
-TRAINING_CODE = ("dataset", "neural3d.config", "neural3d.field", "neural3d.rendering",
+TRAINING_CODE = ("envelope", "neural3d.config", "neural3d.field", "neural3d.rendering",
                  "neural3d.training", "neural3d.train")
 """The modules whose source a trained field depends on: extraction is not among them, so
 a change to meshing or measuring keeps a finished training (tests/neural3d/test_neural3d_reuse.py

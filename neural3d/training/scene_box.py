@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
-from dataset.core.camera import Intrinsics, project_world_to_image
+from envelope.camera import Intrinsics, project_world_to_image
 
 
 def visual_hull_box_m(

@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 from segment.real_sets.common import IGNORED, RealPhoto, lookup_labels
 
 SET_NAME = "cmp"

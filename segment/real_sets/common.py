@@ -3,7 +3,7 @@ project's classes.
 
 A set's reader (:mod:`segment.real_sets.labelmefacade`, :mod:`segment.real_sets.cmp`)
 lists :class:`RealPhoto` entries from a folder the user points at and maps the set's
-label colours or ids to the project's classes (``dataset.core.classes``: 0 background,
+label colours or ids to the project's classes (``envelope.classes``: 0 background,
 1 wall, 2 window, 3 roof, 4 door, 5 other); pixels no project class fits are
 :data:`IGNORED` and count nowhere (not in an IoU, a WWR or a training loss).
 """
@@ -21,7 +21,7 @@ from segment.photo_io import read_photo_rgb
 PHOTO_TRAIN, PHOTO_VAL, PHOTO_TEST = "train", "val", "test"
 PHOTO_SPLITS = (PHOTO_TRAIN, PHOTO_VAL, PHOTO_TEST)
 """The splits of the real photo sets (:mod:`segment.real_sets.splits`), spelled once; not
-the scene frames' splits (:mod:`dataset.core.protocols`)."""
+the scene frames' splits (:mod:`envelope.protocols`)."""
 IGNORED = 255
 """Label of a pixel that is not counted (unlabelled, or a class that fits no project class)."""
 

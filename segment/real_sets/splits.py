@@ -30,8 +30,8 @@ from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
-from dataset.core.atomic import write_text_atomic
-from dataset.core.cli_errors import add_debug_flag, exit_cli, run_cli
+from envelope.atomic import write_text_atomic
+from envelope.cli_errors import add_debug_flag, exit_cli, run_cli
 from segment.real_sets import SET_NAMES, RealPhoto, read_set
 from segment.real_sets.common import PHOTO_SPLITS, PHOTO_TEST, PHOTO_TRAIN, PHOTO_VAL
 

@@ -13,11 +13,11 @@ import pytest
 from baselines.corners import corners_inside_image
 from baselines.views import ViewError
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.scene_record import Frame, Scene
 from dataset.rendering.render import render_view
-from dataset.scenes.images import write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import read_method_input, write_transforms
+from envelope.camera import Intrinsics, look_at
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import write_depth_m, write_labels, write_rgb
+from envelope.scenes.scene import read_method_input, write_transforms
 
 W, H, DISTANCE_M, EYE_Z_M = 256, 192, 25.0, 4.5
 

@@ -3,7 +3,7 @@
 import pytest
 
 from baselines.aggregate import building_result, combine_values, missing_facade
-from dataset.core.results import FacadeEstimate
+from envelope.results import FacadeEstimate
 
 
 def _result(facades, weighting="alpha"):

@@ -12,7 +12,7 @@ from baselines.backproject import (
 )
 from baselines.plane import Plane, plane_through_points
 from baselines.views import ViewError
-from dataset.core.camera import Intrinsics, look_at, project_world_to_image
+from envelope.camera import Intrinsics, look_at, project_world_to_image
 
 
 def test_size_of_a_rectangle_in_any_frame():

@@ -11,10 +11,10 @@ import baselines.cli
 from baselines import wwr2ds, wwr2dss
 from baselines.cli import scene_folders
 from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
-from dataset.core.method import available_methods
-from dataset.core.results import MethodResult, read_result
-from dataset.core.truth import read_building
-from metrics.compare_args import compare_request, parse_compare_args
+from envelope.method import available_methods
+from envelope.results import MethodResult, read_result
+from envelope.truth import read_building
+from metrics.run.compare_args import compare_request, parse_compare_args
 
 
 def test_scene_folders_and_default_results_folder(tmp_path):

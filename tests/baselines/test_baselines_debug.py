@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from baselines.debug import colour_labels, debug_image_path, draw_corners, write_debug_image
-from dataset.scenes.images import read_rgb
+from envelope.scenes.images import read_rgb
 
 
 def test_names_are_predictable():

@@ -13,8 +13,8 @@ from baselines.facade_mask import (
     tolerance_for_depth_steps,
 )
 from baselines.views import ViewError
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.classes import SemanticClass
+from envelope.camera import Intrinsics, look_at
+from envelope.classes import SemanticClass
 
 L_M, H_M = 12.0, 9.0
 K = Intrinsics.from_fov(256, 256, 60.0)

@@ -9,7 +9,7 @@ from baselines.plane import (
     plane_through_points,
     points_camera_m,
 )
-from dataset.core.camera import Intrinsics
+from envelope.camera import Intrinsics
 
 
 def _plane_points(rng, n):

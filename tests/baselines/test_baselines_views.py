@@ -7,10 +7,10 @@ import pytest
 from baselines_synthetic import facade_pose, window_grid, write_facade_scene
 
 from baselines.views import load_views
-from dataset.core.camera import Intrinsics
-from dataset.scenes.images import write_labels
-from dataset.scenes.scene import read_method_input, read_scene, write_transforms
-from dataset.scenes.scene_validation import InvalidSceneError
+from envelope.camera import Intrinsics
+from envelope.scenes.images import write_labels
+from envelope.scenes.scene import read_method_input, read_scene, write_transforms
+from envelope.scenes.scene_validation import InvalidSceneError
 
 K = Intrinsics.from_fov(64, 48, 60.0)
 FACADE = dict(length_m=12.0, height_m=9.0, windows=window_grid(12.0, 9.0, 4, 3, 1.6, 1.5))

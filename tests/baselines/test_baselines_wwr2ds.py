@@ -9,11 +9,11 @@ from baselines_synthetic import facade_pose, render_facade, window_grid, write_f
 
 from baselines.views import FacadeView
 from baselines.wwr2ds import Wwr2dsConfig, main, measure_view_2ds, run_2ds
-from dataset.core.camera import Intrinsics
-from dataset.core.classes import SemanticClass
-from dataset.core.results import read_result
-from dataset.core.scene_record import Frame
-from dataset.scenes.scene import read_method_input, write_transforms
+from envelope.camera import Intrinsics
+from envelope.classes import SemanticClass
+from envelope.results import read_result
+from envelope.scene_record import Frame
+from envelope.scenes.scene import read_method_input, write_transforms
 
 L_M, H_M = 12.0, 9.0
 WINDOWS = window_grid(L_M, H_M, 4, 3, 1.6, 1.5)

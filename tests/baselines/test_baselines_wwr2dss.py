@@ -21,12 +21,12 @@ from baselines.wwr2dss import (
     rectify_views,
     run_2dss,
 )
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.results import read_result
-from dataset.core.scene_record import Frame
 from dataset.rendering.render import render_ground_truth
-from dataset.scenes.images import write_depth_m, write_labels, write_rgb
-from dataset.scenes.scene import read_method_input, write_transforms
+from envelope.camera import Intrinsics, look_at
+from envelope.results import read_result
+from envelope.scene_record import Frame
+from envelope.scenes.images import write_depth_m, write_labels, write_rgb
+from envelope.scenes.scene import read_method_input, write_transforms
 
 L_M, H_M = 12.0, 9.0
 WINDOWS = window_grid(L_M, H_M, 4, 3, 1.6, 1.5)

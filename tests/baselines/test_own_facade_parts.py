@@ -11,8 +11,8 @@ from baselines.facade_cells import CellConfig, measure_facade_cells
 from baselines.plane_merge import MergeConfig, facade_plane, merge_view_planes, same_facade
 from baselines.posed_views import PosedView
 from baselines.view_planes import UP, PlaneFitConfig, ViewPlane, find_view_planes
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.scene_record import Frame
+from envelope.camera import Intrinsics, look_at
+from envelope.scene_record import Frame
 
 K = Intrinsics.from_fov(160, 120, 60.0)
 L_M, H_M = 10.0, 6.0  # the synthetic facade: y = 0, x in [0, L], z in [0, H], facing -y

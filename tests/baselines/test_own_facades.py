@@ -1,5 +1,6 @@
 """2D-SS and 2D-S on views without facade ids find the facades themselves
-(baselines.own_facades), checked against the truth by the one scoring rule (metrics.errors)."""
+(baselines.own_facades), checked against the truth by the one scoring rule
+(metrics.score.errors)."""
 
 from __future__ import annotations
 
@@ -18,17 +19,17 @@ from baselines.posed_views import PosedView
 from baselines.view_planes import find_view_planes
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.classes import SemanticClass
-from dataset.core.scene_record import Frame
-from dataset.core.truth import Building
 from dataset.generate import GenerateConfig
 from dataset.presets import build_building, preset_recipes
 from dataset.rendering.render import render_ground_truth
-from dataset.scenes.images import write_labels
-from dataset.scenes.scene import read_method_input, read_scene, write_transforms
 from dataset.scenes.scene_writer import generate_scene
-from metrics.errors import building_errors, facade_errors
+from envelope.camera import Intrinsics, look_at
+from envelope.classes import SemanticClass
+from envelope.scene_record import Frame
+from envelope.scenes.images import write_labels
+from envelope.scenes.scene import read_method_input, read_scene, write_transforms
+from envelope.truth import Building
+from metrics.score.errors import building_errors, facade_errors
 
 K = Intrinsics.from_fov(160, 120, 60.0)
 L_M, H_M = 10.0, 6.0

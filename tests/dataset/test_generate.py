@@ -11,7 +11,6 @@ from conftest import TINY_CONFIG, assert_complete_scene, make_box_building
 from paths import REPO_ROOT
 
 import dataset.scenes.scene_writer as scene_writer
-from dataset.core.truth import Building
 from dataset.generate import (
     GenerateConfig,
     generate_preset,
@@ -20,8 +19,9 @@ from dataset.generate import (
 )
 from dataset.rendering.orbit_views import OrbitConfig
 from dataset.rendering.orbit_views import sample_orbit_views as real_sample_orbit_views
-from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import scene_changes
+from envelope.scenes.scene import read_scene
+from envelope.truth import Building
 
 SMALL = GenerateConfig(resolution=40, views=6)
 

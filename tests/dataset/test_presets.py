@@ -11,8 +11,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from paths import REPO_ROOT
 
-from dataset.core.mesh import LabelledMesh, write_labelled_ply
-from dataset.core.truth import Building, write_building
 from dataset.families import l_shaped, realistic, skyscraper
 from dataset.families.realistic_params import REALISTIC_MODELS
 from dataset.presets import (
@@ -23,6 +21,8 @@ from dataset.presets import (
     preset_ranges,
     preset_recipes,
 )
+from envelope.mesh import LabelledMesh, write_labelled_ply
+from envelope.truth import Building, write_building
 
 ROOT = REPO_ROOT
 RANGES = {
@@ -83,8 +83,8 @@ def test_files_are_identical_across_processes(tiny_buildings, tmp_path):
     # Another interpreter (fresh hash seeds, fresh import order) writes the same bytes.
     code = (
         "import sys; from pathlib import Path; from dataset.presets import *; "
-        "from dataset.core.mesh import write_labelled_ply; "
-        "from dataset.core.truth import write_building; "
+        "from envelope.mesh import write_labelled_ply; "
+        "from envelope.truth import write_building; "
         "b = build_building(preset_recipes('tiny')[0]); o = Path(sys.argv[1]); "
         "write_labelled_ply(o / 'mesh.ply', b.mesh); write_building(o / 'building.json', b.truth)"
     )

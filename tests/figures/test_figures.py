@@ -9,12 +9,12 @@ import pytest
 import trimesh
 from metrics_helpers import make_benchmark
 
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.mesh import LabelledMesh, write_labelled_ply
-from dataset.core.scene_record import Frame, Scene
-from dataset.core.semantic_ply import write_semantic_ply
-from dataset.scenes.images import write_depth_m, write_labels, write_normals, write_rgb
-from dataset.scenes.scene import write_transforms
+from envelope.camera import Intrinsics, look_at
+from envelope.mesh import LabelledMesh, write_labelled_ply
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import write_depth_m, write_labels, write_normals, write_rgb
+from envelope.scenes.scene import write_transforms
+from envelope.semantic_ply import write_semantic_ply
 from figures.make import main
 from figures.meshes import face_labels_from_vertices, render_mesh_views
 from metrics.compare import main as compare_main

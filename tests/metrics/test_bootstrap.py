@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from metrics.bootstrap import BOOTSTRAP_RESAMPLES, INTERVAL_TEXT, bootstrap_interval
+from metrics.score.bootstrap import BOOTSTRAP_RESAMPLES, INTERVAL_TEXT, bootstrap_interval
 
 
 def test_identical_values_have_an_interval_of_zero_width():

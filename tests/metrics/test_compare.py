@@ -9,8 +9,8 @@ import pytest
 from metrics_helpers import make_benchmark
 
 from metrics.compare import main
-from metrics.report import read_building_errors_csv
-from metrics.tables import read_csv_rows
+from metrics.report.report import read_building_errors_csv
+from metrics.report.tables import read_csv_rows
 
 TOL = 1e-9
 

@@ -20,12 +20,12 @@ from pathlib import Path
 
 import pytest
 
-from dataset.core.results import read_result
-from dataset.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
+from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
+from envelope.results import read_result
 from metrics.compare import main
-from metrics.executors import make_executor
-from metrics.methods import method_specs
-from metrics.runner import MethodSpec, find_scenes, run_missing
+from metrics.run.executors import make_executor
+from metrics.run.methods import method_specs
+from metrics.run.runner import MethodSpec, find_scenes, run_missing
 
 pytestmark = pytest.mark.slow  # every test here starts a local Ray cluster
 

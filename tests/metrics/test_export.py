@@ -1,4 +1,5 @@
-"""metrics.export: the box of tests/export_box.py (walls turned 30 degrees, north stated as 20)
+"""metrics.export.command: the box of tests/export_box.py (walls turned 30 degrees, north stated as
+20)
 gives its bins and per-orientation WWR in every format; WWR 0 stays 0 everywhere; the CityJSON
 passes the official schema and cjval's other checks (tests/cityjson_checks.py).
 
@@ -15,10 +16,10 @@ import pytest
 from cityjson_checks import cityjson_errors
 from export_box import AZIMUTH_DEG, EXPECTED, box_truth, ideal_result, located_result
 
-from dataset.core.orientation import BIN_NAMES, CONVENTIONS, ORIENTATION_BINS, orientation_bin
-from dataset.core.results import write_result
-from dataset.core.truth import write_building
-from metrics.export import FORMATS, ExportInputs, export, main
+from envelope.orientation import BIN_NAMES, CONVENTIONS, ORIENTATION_BINS, orientation_bin
+from envelope.results import write_result
+from envelope.truth import write_building
+from metrics.export.command import FORMATS, ExportInputs, export, main
 
 BINS = ORIENTATION_BINS
 # The ideal result on the truth's facades: facade 1 (W) 0.15, 2 (S) 0, 3 (E) 0.25, 4 (N) missing.

@@ -1,4 +1,5 @@
-"""metrics.export -> geomeppy round trip: the box of tests/export_box.py built from the export's
+"""metrics.export.command -> geomeppy round trip: the box of tests/export_box.py built from the
+export's
 ``block`` with geomeppy (no EnergyPlus needed: eppy ships the IDD), windows set from its
 ``set_wwr_by_orientation``, and the WWR per orientation read back from the IDF's own surfaces
 (eppy's azimuth and area) within 0.01 of the export, WWR 0 included.
@@ -13,8 +14,8 @@ from pathlib import Path
 import pytest
 from export_box import box_truth, ideal_result
 
-from dataset.core.orientation import BIN_NAMES, orientation_bin
-from metrics.export import ExportInputs, export
+from envelope.orientation import BIN_NAMES, orientation_bin
+from metrics.export.command import ExportInputs, export
 
 geomeppy = pytest.importorskip("geomeppy")
 IDD_VERSION = "Energy+V9_2_0.idd"  # the newest IDD eppy 0.6.7 ships

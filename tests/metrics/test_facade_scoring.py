@@ -1,4 +1,4 @@
-"""metrics.facade_scoring: the one scoring rule. Every method's facades are paired with the
+"""metrics.score.facade_scoring: the one scoring rule. Every method's facades are paired with the
 truth's (by id, or by geometry with covered and uncovered walls alike); an estimate on an
 uncovered wall leaves the building's figures, a false positive stays in them, a covered
 facade without an estimate is missed."""
@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 from paths import FIXTURES
 
-from dataset.core.results import FacadeEstimate, MethodResult
-from dataset.core.wwr import ClassAreas
-from dataset.importers.citygml_import import import_citygml
+from dataset.importers.citygml.convert import import_citygml
 from dataset.presets import build_building, preset_recipes
-from metrics.errors import LEFT_OUT_FACADE_ID, building_errors, facade_errors, missed_facades
-from metrics.facade_match import ON_WALL_MAX_DISTANCE_M
-from metrics.facade_scoring import score_result
+from envelope.results import FacadeEstimate, MethodResult
+from envelope.wwr import ClassAreas
+from metrics.score.errors import LEFT_OUT_FACADE_ID, building_errors, facade_errors, missed_facades
+from metrics.score.facade_match import ON_WALL_MAX_DISTANCE_M
+from metrics.score.facade_scoring import score_result
 
 TOL = 1e-9
 

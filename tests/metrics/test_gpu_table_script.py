@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from dataset.core.results import read_result
+from envelope.results import read_result
 
 ROOT = Path(__file__).resolve().parents[2]
 TABLE = ROOT / "bench" / "neural3d_gpu_table.sh"

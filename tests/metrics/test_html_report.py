@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 from metrics.compare import main as compare_main
-from metrics.html_report import REPORT_FILE, main
-from metrics.mesh_decimate import decimate_vertex_clustering
-from metrics.report import TABLE2_NAME, TABLE3_NAME
-from metrics.report_browser import CHROMIUM, open_report
-from metrics.tables import format_cell, read_csv_rows, read_summary
+from metrics.report.html_report import REPORT_FILE, main
+from metrics.report.mesh_decimate import decimate_vertex_clustering
+from metrics.report.report import TABLE2_NAME, TABLE3_NAME
+from metrics.report.report_browser import CHROMIUM, open_report
+from metrics.report.tables import format_cell, read_csv_rows, read_summary
 
 MAX_REPORT_BYTES = 15_000_000
 

@@ -12,7 +12,7 @@ import pytest
 from dataset import generate
 from dataset.examples.ifc_houses import box_house
 from metrics.compare import main as compare
-from metrics.tables import read_csv_rows
+from metrics.report.tables import read_csv_rows
 
 
 @pytest.mark.slow

@@ -12,12 +12,12 @@ from metrics_helpers import make_benchmark
 
 from baselines.facade_mask import PlaneIsolationConfig
 from baselines.wwr2dss import Wwr2dssConfig
-from dataset.core.method import Method, available_methods
-from dataset.core.method_options import Option, parse_value, with_settings
-from dataset.core.protocols import VIEW_PROTOCOLS
+from envelope.method import Method, available_methods
+from envelope.method_options import Option, parse_value, with_settings
+from envelope.protocols import VIEW_PROTOCOLS
 from metrics.compare import main
-from metrics.compare_args import compare_request, parse_compare_args
-from metrics.method_args import add_method_options, parse_sets
+from metrics.run.compare_args import compare_request, parse_compare_args
+from metrics.run.method_args import add_method_options, parse_sets
 from neural3d.method import SHORT_RUN, Neural3dBudget
 
 

@@ -12,10 +12,10 @@ import sys
 import pytest
 from paths import REPO_ROOT
 
-from dataset.core.method import ENTRY_POINT_GROUP, installed_methods
+from envelope.method import ENTRY_POINT_GROUP, installed_methods
 from metrics.compare import main
-from metrics.report import read_building_errors_csv
-from metrics.tables import read_csv_rows
+from metrics.report.report import read_building_errors_csv
+from metrics.report.tables import read_csv_rows
 
 DOC = REPO_ROOT / "docs" / "adding-a-method.md"
 

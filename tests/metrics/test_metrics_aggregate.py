@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from metrics.aggregate import ALL_FAMILIES, Summary, aggregate_by_family, summarise
-from metrics.errors import BuildingErrors, failed_building
+from metrics.score.aggregate import ALL_FAMILIES, Summary, aggregate_by_family, summarise
+from metrics.score.errors import BuildingErrors, failed_building
 
 
 def _row(scene, family, method, protocol, wwr_ape, iou=None):

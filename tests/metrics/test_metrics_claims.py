@@ -5,16 +5,16 @@ from dataclasses import replace
 import pytest
 from metrics_helpers import make_result, make_truth
 
-from dataset.core.results import read_result, result_filename, write_result
-from dataset.core.wwr import ClassAreas
-from metrics.aggregate import aggregate_by_family, seed_mean, seed_sd
-from metrics.compare_args import parse_seeds
-from metrics.errors import BuildingErrors, building_errors, failed_building
-from metrics.paper_tables import PAPER_TABLE2_LABEL, paper_table2, paper_table3
-from metrics.report_paper import paper_table2_comparison, paper_table3_comparison
-from metrics.report_seeds import seed_spread_table
-from metrics.report_visible import table2_visible_errors
-from metrics.tables import format_cell, read_csv_rows, read_summary, to_csv
+from envelope.results import read_result, result_filename, write_result
+from envelope.wwr import ClassAreas
+from metrics.report.paper_tables import PAPER_TABLE2_LABEL, paper_table2, paper_table3
+from metrics.report.report_paper import paper_table2_comparison, paper_table3_comparison
+from metrics.report.report_seeds import seed_spread_table
+from metrics.report.report_visible import table2_visible_errors
+from metrics.report.tables import format_cell, read_csv_rows, read_summary, to_csv
+from metrics.run.compare_args import parse_seeds
+from metrics.score.aggregate import aggregate_by_family, seed_mean, seed_sd
+from metrics.score.errors import BuildingErrors, building_errors, failed_building
 
 
 def _run(scene, seed, wwr_ape, iou=0.9):
@@ -104,8 +104,8 @@ def test_paper_figures_sit_beside_ours_where_the_paper_has_the_row():
 
 
 def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
-    from dataset.core.truth import write_building
-    from metrics.runner import MethodSpec, find_scenes, run_missing
+    from envelope.truth import write_building
+    from metrics.run.runner import MethodSpec, find_scenes, run_missing
 
     write_building(tmp_path / "data" / "a" / "building.json", make_truth("a"))
     scenes = find_scenes(tmp_path / "data")
@@ -137,8 +137,8 @@ def test_claims_tables_leave_out_tables_without_rows():
 
 
 def test_report_sections_show_the_visible_table_with_its_intervals(tmp_path):
-    from metrics.html_claims import claims_sections
-    from metrics.html_report import table2_html, table3_html
+    from metrics.report.html_claims import claims_sections
+    from metrics.report.html_report import table2_html, table3_html
 
     rows = [BuildingErrors(s, "realistic", "neural3d", "train", wwr_ape=e, footprint_iou=0.97,
                            wwr_ape_visible=e / 2) for s, e in (("a", 2.0), ("b", 4.0))]
@@ -147,7 +147,7 @@ def test_report_sections_show_the_visible_table_with_its_intervals(tmp_path):
     html = claims_sections(tmp_path)
     assert "visible facade" in html and "1.50 ± 0.50 [1.00, 2.00]" in html
     assert "seed" not in html.lower()  # no seed table written
-    from metrics.report import table2_errors, table3_footprint_iou
+    from metrics.report.report import table2_errors, table3_footprint_iou
 
     names = {"neural3d": "BuildNet3D"}
     paper2 = read_csv_rows(to_csv(paper_table2_comparison(groups, names)))

@@ -7,8 +7,8 @@ import pytest
 from metrics_helpers import make_result, make_truth
 from shapely.geometry import MultiPolygon, Point, Polygon, box
 
-from dataset.core.results import FacadeEstimate
-from metrics.errors import (
+from envelope.results import FacadeEstimate
+from metrics.score.errors import (
     absolute_percentage_error,
     building_errors,
     facade_errors,

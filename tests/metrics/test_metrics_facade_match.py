@@ -1,4 +1,5 @@
-"""metrics.facade_match: a method's own facades take the truth's facade ids by normal and centre."""
+"""metrics.score.facade_match: a method's own facades take the truth's facade ids by normal and
+centre."""
 
 from dataclasses import replace
 
@@ -6,11 +7,11 @@ import numpy as np
 import pytest
 from sdf_shapes import banded_labels, cylinder_sdf
 
-from dataset.core.results import FacadeEstimate
-from dataset.core.truth import FacadeTruth
-from dataset.core.wwr import wwr_from_areas
 from dataset.presets import build_building, preset_recipes
-from metrics.facade_match import distance_to_outline_m, has_facade_geometry, match_facades
+from envelope.results import FacadeEstimate
+from envelope.truth import FacadeTruth
+from envelope.wwr import wwr_from_areas
+from metrics.score.facade_match import distance_to_outline_m, has_facade_geometry, match_facades
 from neural3d.extract import facade_estimates
 from neural3d.extraction.measure import measure_semantic_mesh
 from neural3d.extraction.meshing import extract_mesh, label_vertices

@@ -5,8 +5,8 @@ from dataclasses import asdict
 import pytest
 
 from dataset.benchmark_cache import DefaultBenchmark
-from metrics.methods import method_specs
 from metrics.robustness import RobustnessStudy
+from metrics.run.methods import method_specs
 from neural3d.method import Neural3dBudget
 
 
@@ -27,7 +27,7 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
                                     "threads": 2, "device": "cpu"}
     assert n3d.config["train"] == {**asdict(preset_config("tiny")), "eval_max_frames": 1,
                                    "iterations": 300}
-    assert n3d.code == ("dataset", "neural3d") and s2dss.code == ("dataset", "baselines")
+    assert n3d.code == ("envelope", "neural3d") and s2dss.code == ("envelope", "baselines")
     assert n3d.config["resolution"] == 96  # matched against ExtractConfig.resolution
     # the whole extraction config keys the cache, so a result measured otherwise is redone
     from neural3d.extraction.extract_config import ExtractConfig

@@ -2,9 +2,9 @@
 
 import pytest
 
-from metrics.aggregate import aggregate_by_family
-from metrics.errors import BuildingErrors, failed_building
-from metrics.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.report.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.score.aggregate import aggregate_by_family
+from metrics.score.errors import BuildingErrors, failed_building
 
 ROWS = [
     BuildingErrors("a", "skyscraper", "2D-S", "ideal", wwr_est=0.3, wwr_true=0.25, wwr_ape=20.0),

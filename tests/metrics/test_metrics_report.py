@@ -2,15 +2,15 @@
 
 import pytest
 
-from metrics.aggregate import aggregate_by_family
-from metrics.errors import BuildingErrors, failed_building
-from metrics.report import (
+from metrics.report.report import (
     per_building_table,
     read_building_errors_csv,
     table2_errors,
     table3_footprint_iou,
 )
-from metrics.tables import to_csv
+from metrics.report.tables import to_csv
+from metrics.score.aggregate import aggregate_by_family
+from metrics.score.errors import BuildingErrors, failed_building
 
 ROWS = [
     BuildingErrors("a", "skyscraper", "2D-S", "ideal", wwr_est=0.3, wwr_true=0.25, wwr_ape=20.0,

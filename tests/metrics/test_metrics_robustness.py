@@ -8,16 +8,16 @@ import json
 
 import pytest
 
-from dataset.core.provenance import make_provenance, provenance_changes
-from dataset.core.results import read_result
 from dataset.degrade.spec import parse_specs
+from envelope.provenance import make_provenance, provenance_changes
+from envelope.results import read_result
 from metrics.compare import main
-from metrics.degraded import CONFIG_KEY, with_degradation
-from metrics.errors import BuildingErrors
-from metrics.report import read_building_errors_csv
+from metrics.report.report import read_building_errors_csv
+from metrics.report.robustness_plot import plot_robustness
 from metrics.robustness import RobustnessStudy, robustness_table, summarise
-from metrics.robustness_plot import plot_robustness
-from metrics.runner import MethodSpec
+from metrics.run.degraded import CONFIG_KEY, with_degradation
+from metrics.run.runner import MethodSpec
+from metrics.score.errors import BuildingErrors
 
 
 def _row(scene: str, method: str, ape: float | None, status: str = "ok") -> BuildingErrors:
@@ -60,7 +60,7 @@ def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
     assert degraded.config == {"a": 1, CONFIG_KEY: record}
     # A clean result is never reused for a degraded run, nor one of another severity.
     def record(config):
-        return make_provenance(config, modules=("dataset.core.wwr",), inputs={})
+        return make_provenance(config, modules=("envelope.wwr",), inputs={})
 
     assert provenance_changes(record({"a": 1}), record(degraded.config))
     assert provenance_changes(record({"a": 1, CONFIG_KEY: [

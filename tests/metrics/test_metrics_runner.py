@@ -6,9 +6,9 @@ from pathlib import Path
 import pytest
 from metrics_helpers import make_result, make_truth
 
-from dataset.core.results import read_result
-from dataset.core.truth import write_building
-from metrics.runner import MethodSpec, find_scenes, run_missing
+from envelope.results import read_result
+from envelope.truth import write_building
+from metrics.run.runner import MethodSpec, find_scenes, run_missing
 
 
 class FakeMethod:

@@ -6,8 +6,7 @@ import re
 
 import pytest
 
-from metrics.aggregate import Summary
-from metrics.tables import (
+from metrics.report.tables import (
     Table,
     latex_escape,
     read_csv_rows,
@@ -17,6 +16,7 @@ from metrics.tables import (
     to_text,
     write_table,
 )
+from metrics.score.aggregate import Summary
 
 TABLE = Table(
     name="t_1",

@@ -18,7 +18,7 @@ from dataset.generate import main as generate_main
 @pytest.mark.slow
 def test_metrics_compare_runs_every_method_on_imported_scenes(box_building, tmp_path):
     from metrics.compare import main as compare_main
-    from metrics.report import read_building_errors_csv
+    from metrics.report.report import read_building_errors_csv
 
     write_blenderproc_output(tmp_path / "bproc" / "house", box_building, "generator")
     data = tmp_path / "scenes"

@@ -1,4 +1,5 @@
-"""metrics.orientation_errors and the report's section: WWR error per orientation in percentage
+"""metrics.score.orientation_errors and the report's section: WWR error per orientation in
+percentage
 points and the share of facades within ±5 / ±10 pp, against errors worked out by hand.
 
 The box (tests/export_box.py): true WWR N 0.2, E 0.3, S 0, W 2/15. Its ideal result: E 0.25
@@ -14,17 +15,17 @@ import pytest
 from export_box import box_truth, ideal_result, located_result
 from metrics_helpers import make_benchmark
 
-from metrics.aggregate import ALL_FAMILIES
 from metrics.compare import main as compare_main
-from metrics.html_orientation import orientation_section
-from metrics.orientation_errors import (
+from metrics.report.html_orientation import orientation_section
+from metrics.report.report_orientation import orientation_table
+from metrics.report.tables import read_csv_rows, write_table
+from metrics.score.aggregate import ALL_FAMILIES
+from metrics.score.orientation_errors import (
     ORIENTATION_TABLE_NAME,
     orientation_errors,
     orientation_errors_of,
-    orientation_table,
     summarise_orientations,
 )
-from metrics.tables import read_csv_rows, write_table
 
 
 def _by_bin(rows):

@@ -17,12 +17,12 @@ from pathlib import Path
 
 import pytest
 
-from dataset.core.progress import progress_bar
-from dataset.core.results import read_result
-from dataset.executors.ray_tasks import TaskResources
-from metrics.executors import make_executor
-from metrics.methods import method_specs
-from metrics.runner import find_scenes, run_missing
+from envelope.executors.ray_tasks import TaskResources
+from envelope.progress import progress_bar
+from envelope.results import read_result
+from metrics.run.executors import make_executor
+from metrics.run.methods import method_specs
+from metrics.run.runner import find_scenes, run_missing
 from neural3d.method import METHOD_NEURAL3D, Neural3dBudget, record_config, reserve
 
 

@@ -8,20 +8,20 @@ from pathlib import Path
 import pytest
 from metrics_helpers import make_result, make_truth
 
-from dataset.core.provenance import (
+from envelope.provenance import (
     Provenance,
     code_fingerprint,
     make_provenance,
     provenance_changes,
 )
-from dataset.core.results import read_result, write_result
-from dataset.core.truth import write_building
-from metrics.aggregate import aggregate_by_family
+from envelope.results import read_result, write_result
+from envelope.truth import write_building
 from metrics.compare import main
-from metrics.errors import building_errors
-from metrics.report import table2_errors
-from metrics.runner import MethodSpec, find_scenes, run_missing
-from metrics.tables import read_csv_rows
+from metrics.report.report import table2_errors
+from metrics.report.tables import read_csv_rows
+from metrics.run.runner import MethodSpec, find_scenes, run_missing
+from metrics.score.aggregate import aggregate_by_family
+from metrics.score.errors import building_errors
 
 TOY_SOURCE = '''"""A throwaway method for the cache tests."""
 from dataclasses import replace
@@ -33,14 +33,14 @@ def run(result, scene_dir, protocol):
 
 
 def test_record_round_trip_and_changes_in_words():
-    a = make_provenance({"k": 1, "nested": {"x": (1, 2)}}, modules=("dataset.core.wwr",),
+    a = make_provenance({"k": 1, "nested": {"x": (1, 2)}}, modules=("envelope.wwr",),
                         inputs={"scene": "abc"})
     assert Provenance.from_json_dict(a.to_json_dict()) == a
     assert provenance_changes(a, a) == []
     b = replace(a, config={"k": 2, "nested": {"x": [1, 3]}}, inputs={"scene": "def"},
-                code={"dataset.core.wwr": "0" * 16}, environment={**a.environment, "numpy": "0.1"})
+                code={"envelope.wwr": "0" * 16}, environment={**a.environment, "numpy": "0.1"})
     said = [str(c) for c in provenance_changes(a, b)]
-    assert said == ["code of dataset.core.wwr changed", "inputs changed (scene re-rendered)",
+    assert said == ["code of envelope.wwr changed", "inputs changed (scene re-rendered)",
                     "config changed: k 1 -> 2, nested.x [1, 2] -> [1, 3]",
                     f"numpy {a.environment['numpy']} -> 0.1"]
     assert [c.part for c in provenance_changes(None, a)] == ["record"]

@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import pytest
 
-from dataset.core.provenance import code_fingerprint
+from envelope.provenance import code_fingerprint
 from metrics.publish import main, publish, read_record, record_of, stale_code
 
 

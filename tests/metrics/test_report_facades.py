@@ -1,11 +1,11 @@
-"""metrics.report_facades: coverage, false positives and WWR points from per-facade rows,
+"""metrics.report.report_facades: coverage, false positives and WWR points from per-facade rows,
 hand-computed."""
 
 import pytest
 
-from metrics.aggregate import ALL_FAMILIES, Summary
-from metrics.errors import FacadeErrors
-from metrics.report_facades import facade_scores_table
+from metrics.report.report_facades import facade_scores_table
+from metrics.score.aggregate import ALL_FAMILIES, Summary
+from metrics.score.errors import FacadeErrors
 
 TOL = 1e-9
 

@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 from conftest import make_box_building
 
-from dataset.core.mesh import LabelledMesh, write_labelled_ply
-from dataset.core.method_input import ALL_INPUTS, MethodInput, method_input
-from dataset.core.protocols import VIEW_PROTOCOLS
-from dataset.core.truth import read_building, write_building
-from dataset.scenes.scene import read_method_input, read_scene
-from metrics.methods import METHODS, built_in_method, spec_from_method
-from metrics.runner import Job, run_job
+from envelope.mesh import LabelledMesh, write_labelled_ply
+from envelope.method_input import ALL_INPUTS, MethodInput, method_input
+from envelope.protocols import VIEW_PROTOCOLS
+from envelope.scenes.scene import read_method_input, read_scene
+from envelope.truth import read_building, write_building
+from metrics.run.methods import METHODS, built_in_method, spec_from_method
+from metrics.run.runner import Job, run_job
 from neural3d.method import Neural3dBudget
 
 NAME = "box"  # both copies carry the same folder name: a scene's name is in its results

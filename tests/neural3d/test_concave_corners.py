@@ -19,7 +19,7 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 from neural3d.extraction.measure import measure_semantic_mesh
 from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 
@@ -118,7 +118,7 @@ def test_a_sharp_corner_from_a_perfect_field_is_left_where_it_is():
     0.1 m² (the mesh's own shortfall, about a voxel's height of wall at the roof and the
     ground, is the count's, not the stage's)."""
     from bench.oracle_measure import OracleField
-    from dataset.core.mesh import LabelledMesh
+    from envelope.mesh import LabelledMesh
     from neural3d.extraction.meshing import extract_mesh, label_vertices
 
     mesh, face_label = _prism(0.0)

@@ -12,12 +12,12 @@ from sdf_shapes import banded_labels, box_sdf
 from shapely.geometry import box as rectangle
 
 import neural3d.field.trained
-from dataset.core.classes import CLASS_NAMES
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.results import read_result, result_filename
-from dataset.core.semantic_ply import read_semantic_ply
-from dataset.core.truth import FacadeTruth
-from metrics.errors import facade_errors
+from envelope.classes import CLASS_NAMES
+from envelope.footprint import geojson_to_polygon
+from envelope.results import read_result, result_filename
+from envelope.semantic_ply import read_semantic_ply
+from envelope.truth import FacadeTruth
+from metrics.score.errors import facade_errors
 from neural3d.extract import ExtractConfig, extract_run, main, measure_field
 
 BOX_LO, BOX_HI = [-3.0, -2.0, 0.0], [3.0, 2.0, 10.0]  # window band 3-6 m: WWR 0.3

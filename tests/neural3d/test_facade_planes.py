@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from sdf_shapes import banded_labels, box_sdf
 
-from dataset.core.classes import FACADE_CLASSES
-from dataset.core.mesh import triangle_normals
+from envelope.classes import FACADE_CLASSES
+from envelope.mesh import triangle_normals
 from neural3d.extraction.facade_groups import class_area_m2, group_facade_faces
 from neural3d.extraction.facade_planes import (
     azimuth_offset,

@@ -5,7 +5,7 @@ import pytest
 from scipy.special import erf
 from sdf_shapes import box_sdf
 
-from dataset.core.classes import NUM_CLASSES, SemanticClass
+from envelope.classes import NUM_CLASSES, SemanticClass
 from neural3d.extraction.facade_groups import class_area_m2
 from neural3d.extraction.facade_split import split_facade_area_by_probability
 from neural3d.extraction.measure import measure_semantic_mesh

@@ -6,7 +6,7 @@ from sdf_shapes import box_sdf, cylinder_sdf, l_prism_sdf
 from shapely.geometry import MultiPolygon, Point, Polygon
 from shapely.geometry import box as rectangle
 
-from dataset.core.footprint import geojson_to_polygon, polygon_to_geojson
+from envelope.footprint import geojson_to_polygon, polygon_to_geojson
 from neural3d.extraction.footprint import footprint_from_sdf
 
 SCENE_LO, SCENE_HI = np.array([-2.0, -2.0, -1.0]), np.array([14.0, 14.0, 10.0])

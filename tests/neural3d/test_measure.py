@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from sdf_shapes import banded_labels, box_sdf, cylinder_sdf, l_prism_sdf
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 from neural3d.extraction.facade_groups import class_area_m2, group_facade_faces
 from neural3d.extraction.measure import measure_semantic_mesh
 from neural3d.extraction.measure_config import MeasureConfig, MeasureStages

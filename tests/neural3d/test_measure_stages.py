@@ -16,9 +16,9 @@ from test_concave_corners import _l_prism
 from test_measure import _recessed_box
 from test_occluded_facade import _building
 
-from dataset.core.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
-from dataset.rendering.raycast import Raycaster
-from dataset.rendering.visibility import seen_from_outside
+from envelope.classes import FACADE_CLASSES, NUM_CLASSES, SemanticClass
+from envelope.geometry.raycast import Raycaster
+from envelope.geometry.visibility import seen_from_outside
 from neural3d.extraction.concave_corners import concave_corner_fill
 from neural3d.extraction.extract_config import STAGES, ExtractConfig, without_stages
 from neural3d.extraction.facade_groups import check_mesh_inputs, class_area_m2, group_faces

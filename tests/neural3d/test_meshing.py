@@ -6,8 +6,8 @@ import pytest
 import trimesh
 from sdf_shapes import box_sdf
 
-from dataset.core.mesh import triangle_areas_m2
-from dataset.core.semantic_ply import read_semantic_ply, write_semantic_ply
+from envelope.mesh import triangle_areas_m2
+from envelope.semantic_ply import read_semantic_ply, write_semantic_ply
 from neural3d.extraction.meshing import (
     color_vertices,
     extract_mesh,

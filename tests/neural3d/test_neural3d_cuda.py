@@ -12,8 +12,8 @@ from conftest import BOX_SIZE_M
 from neural3d_scene import write_ring_scene
 from test_neural3d_train import SHORT, SURFACE_TOL_M, box_surface_points
 
-from dataset.core.footprint import geojson_to_polygon
-from dataset.scenes.scene import read_method_input, read_scene
+from envelope.footprint import geojson_to_polygon
+from envelope.scenes.scene import read_method_input, read_scene
 from neural3d.config import preset_config
 from neural3d.extract import ExtractConfig, extract_run
 from neural3d.field.trained import build_field, load_trained_field

@@ -5,8 +5,8 @@ import pytest
 import torch
 from neural3d_scene import write_ring_scene
 
-from dataset.core.camera import unproject_depth_to_world
-from dataset.scenes.scene import read_scene
+from envelope.camera import unproject_depth_to_world
+from envelope.scenes.scene import read_scene
 from neural3d.training.data import (
     background_class,
     frames_to_pixels,

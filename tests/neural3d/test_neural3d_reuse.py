@@ -10,8 +10,8 @@ import torch
 from neural3d_scene import write_ring_scene
 from paths import REPO_ROOT
 
-from dataset.core.scene_record import scene_name
-from dataset.scenes.scene import read_method_input
+from envelope.scene_record import scene_name
+from envelope.scenes.scene import read_method_input
 from neural3d.config import config_to_dict, preset_config
 from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
 from neural3d.method import Neural3dBudget, run_neural3d, train_config

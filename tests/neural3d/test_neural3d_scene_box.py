@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from dataset.core.camera import Intrinsics, look_at, project_world_to_image
+from envelope.camera import Intrinsics, look_at, project_world_to_image
 from neural3d.training.scene_box import visual_hull_box_m
 
 LO, HI = np.array([-4.0, -2.0, 0.0]), np.array([4.0, 2.0, 6.0])

@@ -11,7 +11,7 @@ import torch
 from neural3d_scene import write_ring_scene
 from paths import REPO_ROOT
 
-from dataset.core.truth import write_building
+from envelope.truth import write_building
 from neural3d.config import preset_config
 from neural3d.extraction.extract_config import ExtractConfig
 from neural3d.method import RUNS_FOLDER

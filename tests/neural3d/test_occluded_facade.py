@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 from neural3d.extraction.measure import measure_semantic_mesh
 from neural3d.extraction.measure_config import MeasureConfig, MeasureStages
 
@@ -98,7 +98,7 @@ def test_front_seen_faces_are_the_facade_a_camera_in_front_meets_first():
     """Every front-wall face is met first by some probe from in front; the balcony (class
     other), the roof and the faces of the other walls' planes (seen by their own probes
     only) are told apart by class and plane."""
-    from dataset.rendering.raycast import Raycaster
+    from envelope.geometry.raycast import Raycaster
     from neural3d.extraction.facade_groups import class_area_m2, group_faces
     from neural3d.extraction.facade_planes import project_onto_facade_planes
     from neural3d.extraction.occluded_facade import front_seen_faces, probe_planes

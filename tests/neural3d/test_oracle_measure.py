@@ -9,8 +9,8 @@ import torch
 import trimesh
 
 from bench.oracle_measure import OracleField, main, scene_box_m
-from dataset.core.classes import NUM_CLASSES, SemanticClass
-from dataset.core.mesh import LabelledMesh
+from envelope.classes import NUM_CLASSES, SemanticClass
+from envelope.mesh import LabelledMesh
 
 WALL, ROOF = int(SemanticClass.WALL), int(SemanticClass.ROOF)
 VOXEL_M = 0.1

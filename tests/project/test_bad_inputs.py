@@ -23,11 +23,11 @@ from paths import REPO_ROOT
 
 from baselines import wwr2ds, wwr2dss
 from dataset import generate, importer
-from dataset.core.mesh import LabelledMesh, write_labelled_ply
-from dataset.core.results import read_result
-from dataset.core.warnings_summary import summarise_warnings
-from dataset.importers.meta_data import read_meta_data, write_meta_data
-from dataset.scenes.scene import read_scene
+from dataset.importers.buildnet3d.meta_data import read_meta_data, write_meta_data
+from envelope.mesh import LabelledMesh, write_labelled_ply
+from envelope.results import read_result
+from envelope.scenes.scene import read_scene
+from envelope.warnings_summary import summarise_warnings
 from metrics import compare
 from neural3d import extract, train
 from neural3d.config import config_to_dict, preset_config
@@ -94,7 +94,7 @@ def test_unknown_class_id_in_a_train_view_stops_training(scene, tmp_path, capsys
 
 def test_degenerate_corners_skip_the_view_with_a_reason(scene, capsys):
     """A facade squashed to one pixel row has no quadrilateral: its facade is missing, said so."""
-    from dataset.scenes.images import read_labels, write_labels
+    from envelope.scenes.images import read_labels, write_labels
 
     path = scene / "semantics" / IDEAL
     labels = read_labels(path)
@@ -113,7 +113,7 @@ def test_degenerate_corners_skip_the_view_with_a_reason(scene, capsys):
 
 
 def test_every_view_degenerate_is_an_error_not_a_number(scene, capsys):
-    from dataset.scenes.images import write_labels
+    from envelope.scenes.images import write_labels
 
     for path in (scene / "semantics").glob("ideal_*.png"):
         write_labels(path, np.zeros((64, 64)))

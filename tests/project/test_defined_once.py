@@ -13,9 +13,9 @@ import pytest
 from paths import REPO_ROOT
 
 ROOT = REPO_ROOT
-PACKAGES = ("dataset", "baselines", "neural3d", "segment", "metrics", "figures")
+PACKAGES = ("envelope", "dataset", "baselines", "neural3d", "segment", "metrics", "figures")
 # Importers that issue 17 works on at the same time as this check was written; their frame
-# splits are converted to dataset.core.protocols' names when both branches meet.
+# splits are converted to envelope.protocols' names when both branches meet.
 
 
 def sources() -> list[Path]:
@@ -116,7 +116,7 @@ def test_protocol_and_split_names_are_spelled_only_in_dataset_protocols():
         spelled += [f"{name}:{line} {value!r}" for line, value in code_strings(path)
                     if value in ("ideal", "multi", "train", "eval")]
     # the real photo sets' own train/val/test (segment.real_sets.common) are not scene splits
-    allowed = ("dataset/core/protocols.py:", "segment/real_sets/common.py:")
+    allowed = ("envelope/protocols.py:", "segment/real_sets/common.py:")
     assert spelled and all(s.startswith(allowed) for s in spelled), spelled
 
 
@@ -125,7 +125,7 @@ def test_the_class_palette_is_defined_once():
     # the class colours written out, e.g. (40, 110, 230), and the colour of unknown ids
     colours = sorted(set(where(constant_tuple(40, 110, 230)) + where(constant_tuple(200, 200, 200))
                          + where(constant_tuple(255, 0, 255))))
-    assert len(colours) == 2 and all(c.startswith("dataset/core/classes.py:") for c in colours)
+    assert len(colours) == 2 and all(c.startswith("envelope/classes.py:") for c in colours)
 
 
 @pytest.mark.slow
@@ -135,7 +135,7 @@ def test_each_default_is_assigned_once():
         assert len(where(top_level(name))) == 1, (name, where(top_level(name)))
     mesh_resolution = where(field_default("resolution", 256))
     assert len(mesh_resolution) == 1, mesh_resolution
-    # face normals and in-plane bases: one helper each (dataset.core.mesh)
+    # face normals and in-plane bases: one helper each (envelope.mesh)
     for matches in (top_level("triangle_normals"), top_level("plane_bases"), helper_axis):
         assert len(where(matches)) == 1, where(matches)
     assert where(top_level("face_normals")) == []

@@ -11,7 +11,7 @@ import pytest
 from paths import REPO_ROOT
 
 ROOT = REPO_ROOT
-PACKAGES = ("dataset", "baselines", "neural3d", "segment", "metrics", "figures")
+PACKAGES = ("envelope", "dataset", "baselines", "neural3d", "segment", "metrics", "figures")
 FOLDERS = (*PACKAGES, "tests", "bench", "scripts", "docs")
 DOCS = sorted(p for p in [ROOT / "README.md", *(ROOT / "docs").glob("*.md")]
               if p.name != "decisions.md")
@@ -69,8 +69,8 @@ def test_every_dotted_name_in_the_docs_resolves(doc):
 
 
 def test_the_checks_see_a_stale_name():
-    assert resolves("dataset.core.wwr.wwr_from_areas")
-    assert not resolves("dataset.core.wwr.no_such_function")
+    assert resolves("envelope.wwr.wwr_from_areas")
+    assert not resolves("envelope.wwr.no_such_function")
     assert not resolves("dataset.cameras")
-    assert PATH.findall("see `neural3d/device.py` and dataset/core/wwr.py.") == [
-        "neural3d/device.py", "dataset/core/wwr.py"]
+    assert PATH.findall("see `neural3d/device.py` and envelope/wwr.py.") == [
+        "neural3d/device.py", "envelope/wwr.py"]

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from paths import REPO_ROOT
 
-from dataset.core.results import read_result
-from dataset.scenes.scene import read_scene
+from envelope.results import read_result
+from envelope.scenes.scene import read_scene
 
 ROOT = REPO_ROOT
 

@@ -1,4 +1,4 @@
-"""metrics and figures know methods only through dataset.core.method.Method: no name checks,
+"""metrics and figures know methods only through envelope.method.Method: no name checks,
 and metrics' code names no method. Read from the syntax tree: docstrings and comments may
 name a method, code may not."""
 
@@ -10,7 +10,7 @@ from paths import REPO_ROOT
 ROOT = REPO_ROOT
 METHOD_NAMES = frozenset({"2D-S", "2D-SS", "neural3d"})
 # the paper's own method names, transcribed with its figures (they coincide with ours)
-PAPER_FIGURES = "metrics/paper_tables.py"
+PAPER_FIGURES = "metrics/report/paper_tables.py"
 
 
 def _docstrings(tree: ast.AST) -> set[int]:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import torch
 
-from dataset.core.classes import NUM_CLASSES, SemanticClass
+from envelope.classes import NUM_CLASSES, SemanticClass
 from segment.calibrate import (
     MARGIN_EDGES,
     area_and_iou,

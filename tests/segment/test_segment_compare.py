@@ -10,15 +10,10 @@ import pytest
 from segment_plugin import install_toy_plugin
 
 from metrics.compare import main
-from metrics.errors import BuildingErrors
-from metrics.predicted_masks import (
-    MasksRequest,
-    exact_vs_predicted_table,
-    masks_key,
-    parse_masks,
-    splits_read,
-)
-from metrics.runner import MethodSpec
+from metrics.predicted_masks import exact_vs_predicted_table
+from metrics.run.predicted_masks import MasksRequest, masks_key, parse_masks, splits_read
+from metrics.run.runner import MethodSpec
+from metrics.score.errors import BuildingErrors
 from segment.evaluate import SceneIou
 from segment.segmenter import Segmenter
 
@@ -134,8 +129,8 @@ def test_a_method_on_predicted_masks_still_travels_to_another_process(one_scene,
     import pickle
     from dataclasses import replace
 
-    from metrics.methods import method_specs
-    from metrics.predicted_masks import CONFIG_KEY, with_predicted_masks
+    from metrics.run.methods import method_specs
+    from metrics.run.predicted_masks import CONFIG_KEY, with_predicted_masks
 
     spec = method_specs(("2D-S",), ("ideal",), tmp_path / "results")[0]
     scene = next(one_scene.iterdir())

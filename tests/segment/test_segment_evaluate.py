@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from dataset.core.classes import NUM_CLASSES, SemanticClass
-from dataset.scenes.images import read_rgb
-from dataset.scenes.scene import read_scene
-from dataset.scenes.scene_validation import read_frame_labels
+from envelope.classes import NUM_CLASSES, SemanticClass
+from envelope.scenes.images import read_rgb
+from envelope.scenes.scene import read_scene
+from envelope.scenes.scene_validation import read_frame_labels
 from segment.evaluate import (
     confusion_matrix,
     evenly_spaced,

@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from dataset.core.classes import NUM_CLASSES
+from envelope.classes import NUM_CLASSES
 from segment.network import UNet, UNetConfig
 
 

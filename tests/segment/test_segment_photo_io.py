@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from dataset.core.classes import NUM_CLASSES
+from envelope.classes import NUM_CLASSES
 from segment.photo_io import read_photo_rgb
 from segment.predict import main
 from segment.segmenter import network_segmenter, segment_photo

@@ -4,7 +4,7 @@ import shutil
 
 import torch
 
-from dataset.scenes.scene import read_scene
+from envelope.scenes.scene import read_scene
 from segment.network import UNet, UNetConfig
 from segment.predict import main
 from segment.scene_masks import RECORD_KEY

@@ -19,7 +19,7 @@ from real_set_folders import (
     write_labelmefacade,
 )
 
-from dataset.core.classes import SemanticClass as C
+from envelope.classes import SemanticClass as C
 from segment.evaluate_real import evaluate_set, main
 from segment.real_measure import facade_wwr, photo_result, split_scores, wwr_scores
 from segment.real_sets import IGNORED, read_photo_pair, read_set

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from segment_plugin import doc_blocks, install_toy_plugin
 
-from dataset.core.classes import NUM_CLASSES, SemanticClass
+from envelope.classes import NUM_CLASSES, SemanticClass
 from metrics.compare import main
-from metrics.tables import read_csv_rows
+from metrics.report.tables import read_csv_rows
 from segment.segmenter import (
     Segmenter,
     installed_segmenters,

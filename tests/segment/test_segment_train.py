@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 import segment.train
-from dataset.core.classes import CLASS_NAMES
 from dataset.presets import preset_recipes
-from dataset.scenes.images import read_labels, read_rgb, write_labels, write_rgb
-from dataset.scenes.scene import read_scene
-from metrics.runner import find_scenes
+from envelope.classes import CLASS_NAMES
+from envelope.scenes.images import read_labels, read_rgb, write_labels, write_rgb
+from envelope.scenes.scene import read_scene
+from metrics.run.runner import find_scenes
 from segment.augment import AugmentConfig
 from segment.evaluate import masks_scene_iou
 from segment.network import UNetConfig

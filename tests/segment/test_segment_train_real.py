@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from real_set_folders import LMF_PHOTOS, write_cmp, write_labelmefacade
 
-from dataset.core.classes import SemanticClass
+from envelope.classes import SemanticClass
 from segment.augment import IGNORE_LABEL, REAL_PHOTO_AUGMENT, AugmentConfig, augment_frame
 from segment.calibrate import validation_scenes
 from segment.network import UNetConfig

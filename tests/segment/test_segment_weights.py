@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import torch
 
-from dataset.core.classes import CLASS_NAMES
 from dataset.presets import preset_recipes
+from envelope.classes import CLASS_NAMES
 from segment.network import UNet, UNetConfig
 from segment.segmenter import predict_labels
 from segment.train import TrainConfig

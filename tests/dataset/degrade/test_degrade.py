@@ -10,8 +10,6 @@ import numpy as np
 import pytest
 from conftest import make_box_building
 
-from dataset.core.camera import Intrinsics, unproject_depth_to_world
-from dataset.core.classes import SemanticClass
 from dataset.degrade.depth_noise import noisy_depth_m
 from dataset.degrade.masks import (
     bleed_labels,
@@ -24,9 +22,11 @@ from dataset.degrade.masks import (
 from dataset.degrade.poses import perturb_pose, pose_noise
 from dataset.degrade.scene_copy import RECORD_KEY, degrade_scene
 from dataset.degrade.spec import DEGRADATIONS, DegradeSpec, parse_specs, specs_key
-from dataset.scenes.images import read_labels
-from dataset.scenes.scene import read_method_input, read_scene
 from dataset.scenes.scene_writer import GenerateConfig, generate_scene
+from envelope.camera import Intrinsics, unproject_depth_to_world
+from envelope.classes import SemanticClass
+from envelope.scenes.images import read_labels
+from envelope.scenes.scene import read_method_input, read_scene
 
 WALL, WINDOW = int(SemanticClass.WALL), int(SemanticClass.WINDOW)
 SMALL = GenerateConfig(resolution=48, views=6)
@@ -185,8 +185,8 @@ def test_depth_holes_are_read_and_the_baselines_run_on_them(box_scene: Path,
     """Holes on glass (depth 0) are a sensor's, not a broken scene: every frame's depth
     reads, 2D-SS runs; depth missing on most of the building is still refused."""
     from baselines.wwr2dss import run_2dss
-    from dataset.scenes.images import write_depth_m
-    from dataset.scenes.scene_validation import (
+    from envelope.scenes.images import write_depth_m
+    from envelope.scenes.scene_validation import (
         InvalidSceneError,
         read_frame_depth_m,
         read_frame_labels,

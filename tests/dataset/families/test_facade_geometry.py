@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.families.facade_geometry import (
     MIN_GAP_M,
     Opening,
@@ -15,6 +14,7 @@ from dataset.families.facade_geometry import (
     window_grid,
 )
 from dataset.families.polygon_mesh import triangulate_faces
+from envelope.classes import NO_FACADE, SemanticClass
 
 
 def test_frame_reproduces_its_end_points_exactly_and_faces_right():

@@ -13,8 +13,6 @@ from building_checks import (
 from shapely.geometry import MultiLineString, Polygon
 from shapely.ops import polygonize, unary_union
 
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.wwr import ClassAreas
 from dataset.families.heldout import make_heldout, sample_heldout_params
 from dataset.families.heldout_params import HELDOUT_MODELS, HeldoutParams, default_heldout_params
 from dataset.families.heldout_plan import STEPS, bow_footprint
@@ -25,6 +23,8 @@ from dataset.families.heldout_recess import (
 )
 from dataset.families.heldout_roofs import HIP_OVERHANG_M, SHELL_GAP_M, SHELL_THICKNESS_M
 from dataset.families.heldout_setback import tier_floors
+from envelope.footprint import geojson_to_polygon
+from envelope.wwr import ClassAreas
 
 
 @pytest.mark.parametrize("model", [m for m in HELDOUT_MODELS if m != "slope"])

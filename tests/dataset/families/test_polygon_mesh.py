@@ -5,7 +5,6 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon, box
 
-from dataset.core.classes import SemanticClass
 from dataset.families.polygon_mesh import (
     PlanarFace,
     extruded_faces,
@@ -15,6 +14,7 @@ from dataset.families.polygon_mesh import (
     triangulate_faces,
     vertical_quad,
 )
+from envelope.classes import SemanticClass
 
 UP = np.array([0.0, 0.0, 1.0])
 

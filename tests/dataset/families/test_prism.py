@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.core.classes import SemanticClass
 from dataset.families.facade_geometry import wall_faces
 from dataset.families.polygon_mesh import triangulate_faces
 from dataset.families.prism import (
@@ -19,6 +18,7 @@ from dataset.families.prism import (
     prism_walls,
     validate_footprint,
 )
+from envelope.classes import SemanticClass
 
 RECT = np.array([[-4.0, -3.0], [4.0, -3.0], [4.0, 3.0], [-4.0, 3.0]])
 L_SHAPE = np.array([[0.0, 0], [10, 0], [10, 4], [4, 4], [4, 9], [0, 9]])

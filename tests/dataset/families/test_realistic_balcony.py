@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from building_checks import check_closed_bodies
 
-from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.families.facade_geometry import WallFrame
 from dataset.families.polygon_mesh import triangulate_faces
 from dataset.families.realistic import make_realistic
@@ -16,6 +15,7 @@ from dataset.families.realistic_balcony import (
     balcony_faces,
 )
 from dataset.families.realistic_params import RealisticParams, default_realistic_params
+from envelope.classes import NO_FACADE, SemanticClass
 
 
 def test_balcony_parts_have_closed_form_areas():

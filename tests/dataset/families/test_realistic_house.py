@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from building_checks import check_closed_bodies
 
-from dataset.core.classes import SemanticClass
 from dataset.families.realistic import make_realistic
 from dataset.families.realistic_house import (
     CHIMNEY_ABOVE_RIDGE_M,
@@ -13,6 +12,7 @@ from dataset.families.realistic_house import (
     house_layout,
 )
 from dataset.families.realistic_params import RealisticParams
+from envelope.classes import SemanticClass
 
 
 def test_house_facades_and_roof_are_closed_form():

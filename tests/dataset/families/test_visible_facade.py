@@ -5,9 +5,6 @@ import json
 import numpy as np
 import pytest
 
-from dataset.core.classes import SemanticClass
-from dataset.core.truth import read_building, write_building
-from dataset.core.wwr import ClassAreas
 from dataset.families.facade_geometry import WallFrame, WallSpec, rectangle_outline, wall_faces
 from dataset.families.polygon_mesh import triangulate_faces
 from dataset.families.realistic import make_realistic
@@ -23,6 +20,9 @@ from dataset.families.realistic_house import EAVES_OVERHANG_M, ROOF_SHELL_GAP_M
 from dataset.families.realistic_params import RealisticParams, default_realistic_params
 from dataset.families.skyscraper import SkyscraperParams, make_skyscraper
 from dataset.families.visible_facade import hidden_facade_areas_m2
+from envelope.classes import SemanticClass
+from envelope.truth import read_building, write_building
+from envelope.wwr import ClassAreas
 
 WALL, WINDOW, DOOR = SemanticClass.WALL, SemanticClass.WINDOW, SemanticClass.DOOR
 

@@ -1,4 +1,5 @@
-"""dataset.importers.blenderproc: the BuildNet3D BlenderProc generator's and dataparser's layouts,
+"""dataset.importers.buildnet3d.blenderproc: the BuildNet3D BlenderProc generator's and
+dataparser's layouts,
 written on the fly from the conftest box building rendered with dataset.rendering.render exactly as
 bproc_generator/render/generate.py and buildnet_dataparser.py have them, imported back."""
 
@@ -18,12 +19,12 @@ from blenderproc_output import (
 from conftest import BOX_SIZE_M as BOX
 
 from baselines.wwr2dss import run_2dss
-from dataset.core.camera import pixel_centres, unproject_depth_to_world
-from dataset.core.classes import SemanticClass as C
 from dataset.generate import main as generate_main
-from dataset.scenes.images import read_depth_m, read_facade_ids
-from dataset.scenes.scene import read_method_input, read_scene
-from dataset.scenes.scene_validation import read_frame_labels
+from envelope.camera import pixel_centres, unproject_depth_to_world
+from envelope.classes import SemanticClass as C
+from envelope.scenes.images import read_depth_m, read_facade_ids
+from envelope.scenes.scene import read_method_input, read_scene
+from envelope.scenes.scene_validation import read_frame_labels
 
 
 def _views(scene):

@@ -1,14 +1,14 @@
-"""dataset.importers.bodies: bodies found and turned outwards one by one; faces paired round
-edges that more than two faces use (dataset.importers.edge_pairs)."""
+"""dataset.importers.mesh.bodies: bodies found and turned outwards one by one; faces paired round
+edges that more than two faces use (dataset.importers.mesh.edge_pairs)."""
 
 import numpy as np
 import shapely
 import trimesh
 
-from dataset.importers.bodies import orient_bodies
-from dataset.importers.edge_pairs import face_pairs
-from dataset.importers.mesh_files import merge_vertices
-from dataset.rendering.raycast import winding_numbers
+from dataset.importers.mesh.bodies import orient_bodies
+from dataset.importers.mesh.edge_pairs import face_pairs
+from dataset.importers.mesh.mesh_files import merge_vertices
+from envelope.geometry.raycast import winding_numbers
 
 
 def _box(lo, hi) -> trimesh.Trimesh:

@@ -1,4 +1,5 @@
-"""dataset.importers.buildnet3d on the official BuildNet3D-dataset generator's own output.
+"""dataset.importers.buildnet3d.buildnet3d on the official BuildNet3D-dataset generator's own
+output.
 
 tests/fixtures/buildnet3d_generator/ is what the unmodified generator wrote for two
 L-shaped buildings (6 views each at 128 x 128 px; how it was made: SOURCE.md there). The
@@ -23,16 +24,16 @@ from paths import FIXTURES
 from PIL import Image
 
 from baselines.wwr2dss import run_2dss
-from dataset.core.camera import pixel_centres, unproject_depth_to_world
-from dataset.core.classes import SemanticClass as C
-from dataset.core.mesh import read_labelled_ply
 from dataset.generate import main as generate_main
-from dataset.importers.buildnet3d import read_walls
-from dataset.importers.buildnet3d_model import read_segmented_model
-from dataset.scenes.images import read_depth_m, read_facade_ids
-from dataset.scenes.labels import class_mapping
-from dataset.scenes.scene import read_method_input, read_scene
-from dataset.scenes.scene_validation import read_frame_labels
+from dataset.importers.buildnet3d.buildnet3d import read_walls
+from dataset.importers.buildnet3d.buildnet3d_model import read_segmented_model
+from envelope.camera import pixel_centres, unproject_depth_to_world
+from envelope.classes import SemanticClass as C
+from envelope.mesh import read_labelled_ply
+from envelope.scenes.images import read_depth_m, read_facade_ids
+from envelope.scenes.labels import class_mapping
+from envelope.scenes.scene import read_method_input, read_scene
+from envelope.scenes.scene_validation import read_frame_labels
 
 FIXTURE = FIXTURES / "buildnet3d_generator"
 GEN = dict(zip(class_mapping("generator").names, class_mapping("generator").colours))

@@ -16,15 +16,15 @@ import shapely
 import shapely.affinity
 from paths import FIXTURES
 
-from dataset.core.classes import NO_FACADE, SemanticClass
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.mesh import write_labelled_ply
-from dataset.core.truth import write_building
-from dataset.importers.citygml_files import citygml_files, citygml_stem
-from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_polygons import newell_normal
-from dataset.importers.citygml_read import read_citygml
-from dataset.importers.grid_north import grid_north_deg
+from dataset.importers.citygml.convert import import_citygml
+from dataset.importers.citygml.files import citygml_files, citygml_stem
+from dataset.importers.citygml.grid_north import grid_north_deg
+from dataset.importers.citygml.polygons import newell_normal
+from dataset.importers.citygml.read import read_citygml
+from envelope.classes import NO_FACADE, SemanticClass
+from envelope.footprint import geojson_to_polygon
+from envelope.mesh import write_labelled_ply
+from envelope.truth import write_building
 
 FIXTURES = FIXTURES / "citygml"
 IDS = ("4018259", "4018133", "4018149b")
@@ -239,7 +239,7 @@ def test_classes_and_what_is_left_out(imported):
     ("max_opening_depth_m", 0.0, "max_opening_depth_m must be > 0"),
 ])
 def test_config_rejects_bad_tolerances(field, value, message):
-    from dataset.importers.citygml_config import CityGmlConfig
+    from dataset.importers.citygml.config import CityGmlConfig
 
     with pytest.raises(ValueError, match=message):
         CityGmlConfig(**{field: value})

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from paths import FIXTURES
 
-from dataset.core.classes import SemanticClass
-from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_read import read_citygml
+from dataset.importers.citygml.convert import import_citygml
+from dataset.importers.citygml.read import read_citygml
+from envelope.classes import SemanticClass
 
 OGC = FIXTURES / "citygml" / "ogc"
 V2, V3 = OGC / "Building_LOD3-EPSG25832.v2.gml.xz", OGC / "Building_LOD3-EPSG25832.v3.gml.xz"

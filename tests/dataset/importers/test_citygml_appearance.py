@@ -10,15 +10,15 @@ import pytest
 from citygml_boxes import Box, write_boxes
 from PIL import Image
 
-from dataset.core.appearance import SurfaceAppearance
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.classes import SemanticClass
-from dataset.importers.citygml_appearance import face_appearance
-from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_preset import LOD3_DIR
-from dataset.importers.citygml_read import read_citygml
+from dataset.importers.citygml.appearance import face_appearance
+from dataset.importers.citygml.convert import import_citygml
+from dataset.importers.citygml.preset import LOD3_DIR
+from dataset.importers.citygml.read import read_citygml
 from dataset.rendering.render import render_view
 from dataset.rendering.textures import SRGB_GAMMA, prepare_textures, texture_albedo
+from envelope.appearance import SurfaceAppearance
+from envelope.camera import Intrinsics, look_at
+from envelope.classes import SemanticClass
 
 
 def test_texture_coordinates_of_a_real_file_are_reproduced():

@@ -13,13 +13,13 @@ import numpy as np
 import pytest
 from citygml_boxes import Box, write_boxes
 
-from dataset.core.camera import Intrinsics, look_at
-from dataset.core.classes import NO_FACADE, SemanticClass
 from dataset.generate import main as generate_main
-from dataset.importers.citygml_import import import_citygml, import_citygml_building
-from dataset.importers.citygml_type import citygml_building_type
+from dataset.importers.citygml.convert import import_citygml, import_citygml_building
+from dataset.importers.citygml.type import citygml_building_type
 from dataset.rendering.context import CLEARANCE_M, ViewMeshes
 from dataset.rendering.render import render_ground_truth
+from envelope.camera import Intrinsics, look_at
+from envelope.classes import NO_FACADE, SemanticClass
 
 # A street along x: the measured house A (front at y = 0, facing -y, a window), B against
 # its right side (a party wall 10 m deep, 6 m high), C detached further along, D across the
@@ -130,8 +130,8 @@ def test_generate_with_context_keeps_the_truth(street, tmp_path):
 def test_real_street_neighbours_and_types():
     """On the shipped street: 4018207 shares both side walls (terraced), 4018149b's loggias
     hide a fifth of its front (with balconies), 4018133 stands free of the set's buildings."""
-    from dataset.importers.citygml_context import files_near
-    from dataset.importers.citygml_preset import LOD3_DIR, lod3_files
+    from dataset.importers.citygml.context import files_near
+    from dataset.importers.citygml.preset import LOD3_DIR, lod3_files
 
     files = lod3_files()
     types = {}
@@ -148,7 +148,7 @@ def test_real_street_neighbours_and_types():
 def test_the_source_reads_a_folder_as_one_city_model(tmp_path):
     """Two files 20 m apart and one 200 m away: each entry's building has the buildings of
     the files within 30 m as neighbours, and its inputs fingerprint those files."""
-    from dataset.importers.citygml_source import CITYGML_SOURCE
+    from dataset.importers.citygml.source import CITYGML_SOURCE
     from dataset.importers.source import NoOptions
 
     write_boxes(tmp_path / "a.gml", [A])

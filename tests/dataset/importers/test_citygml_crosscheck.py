@@ -1,7 +1,7 @@
 """The render-based cross-check: the renderer's labels, back-projected, give the truth's areas.
 
 Each covered facade of the committed LoD3 buildings is rendered head-on with the project's
-renderer (dataset.importers.citygml_crosscheck); window and gross facade areas from the
+renderer (dataset.importers.citygml.crosscheck); window and gross facade areas from the
 label pixels agree with the polygon truth within the issue's 2 %.
 """
 
@@ -13,14 +13,14 @@ import numpy as np
 import pytest
 from paths import FIXTURES
 
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh
-from dataset.core.truth import Building
-from dataset.importers.citygml_crosscheck import check_facades
-from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_polygons import triangulate_polygon
-from dataset.importers.citygml_preset import LOD3_DIR
-from dataset.importers.citygml_read import read_citygml
+from dataset.importers.citygml.convert import import_citygml
+from dataset.importers.citygml.crosscheck import check_facades
+from dataset.importers.citygml.polygons import triangulate_polygon
+from dataset.importers.citygml.preset import LOD3_DIR
+from dataset.importers.citygml.read import read_citygml
+from envelope.classes import SemanticClass
+from envelope.mesh import LabelledMesh
+from envelope.truth import Building
 
 FIXTURES = FIXTURES / "citygml"
 AGREE = 0.02

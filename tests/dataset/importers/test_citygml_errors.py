@@ -14,9 +14,9 @@ import pytest
 from lxml import etree
 from paths import FIXTURES
 
-from dataset.importers.citygml_files import CityGmlError
-from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_read import read_citygml
+from dataset.importers.citygml.convert import import_citygml
+from dataset.importers.citygml.files import CityGmlError
+from dataset.importers.citygml.read import read_citygml
 
 FIXTURE = FIXTURES / "citygml" / "4018259.xml.xz"
 

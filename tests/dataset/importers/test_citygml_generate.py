@@ -7,11 +7,11 @@ import json
 import pytest
 from paths import FIXTURES
 
-from dataset.core.truth import read_building
 from dataset.generate import main
-from dataset.importers.citygml_import import import_citygml
-from dataset.importers.citygml_preset import LOD3_DIR, lod3_entries, lod3_files
+from dataset.importers.citygml.convert import import_citygml
+from dataset.importers.citygml.preset import LOD3_DIR, lod3_entries, lod3_files
 from dataset.presets import build_building, preset_recipes
+from envelope.truth import read_building
 
 FIXTURES = FIXTURES / "citygml"
 TINY = ["--resolution", "48", "--views", "2", "--quiet"]
@@ -85,8 +85,8 @@ def test_make_lod3_copies_files_with_windows_and_writes_the_manifest(tmp_path):
     import numpy as np
     from PIL import Image
 
-    from dataset.importers.citygml_preset import TEXTURE_MAX_PX
-    from dataset.importers.citygml_preset import main as make_main
+    from dataset.importers.citygml.preset import TEXTURE_MAX_PX
+    from dataset.importers.citygml.preset import main as make_main
 
     src = tmp_path / "models" / "building" / "lod3" / "individual" / "citygml"
     for i in ("4018259", "4018133"):

@@ -1,12 +1,12 @@
-"""dataset.importers.crossings: faces cut along the lines where other faces pass through."""
+"""dataset.importers.mesh.crossings: faces cut along the lines where other faces pass through."""
 
 import numpy as np
 import pytest
 import trimesh
 
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh
-from dataset.importers.crossings import split_crossing_faces
+from dataset.importers.mesh.crossings import split_crossing_faces
+from envelope.classes import SemanticClass
+from envelope.mesh import LabelledMesh
 
 
 def _mesh(*boxes) -> LabelledMesh:

@@ -1,9 +1,10 @@
-"""dataset.importers.facade_grouping: offsets, gaps, narrow pieces, tilted faces, curved walls."""
+"""dataset.importers.mesh.facade_grouping: offsets, gaps, narrow pieces, tilted faces, curved
+walls."""
 
 import numpy as np
 import trimesh
 
-from dataset.importers.facade_grouping import facade_ids_of_faces, group_facades
+from dataset.importers.mesh.facade_grouping import facade_ids_of_faces, group_facades
 
 KW = dict(max_tilt_deg=10.0, angle_tolerance_deg=10.0, offset_tolerance_m=0.3,
           gap_tolerance_m=0.05, min_width_m=0.5)

@@ -1,15 +1,16 @@
-"""dataset.importers.grade and dataset.importers.contact: cutting faces at the ground and where
+"""dataset.importers.mesh.grade and dataset.importers.mesh.contact: cutting faces at the ground and
+where
 bodies touch."""
 
 import numpy as np
 import pytest
 import trimesh
 
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh
-from dataset.importers.bodies import orient_bodies
-from dataset.importers.contact import split_touching_faces
-from dataset.importers.grade import split_at_height
+from dataset.importers.mesh.bodies import orient_bodies
+from dataset.importers.mesh.contact import split_touching_faces
+from dataset.importers.mesh.grade import split_at_height
+from envelope.classes import SemanticClass
+from envelope.mesh import LabelledMesh
 
 
 def _boxes(*bounds) -> LabelledMesh:
@@ -60,8 +61,8 @@ def test_flush_faces_of_overlapping_solids_count_once():
 
 
 def test_walls_overlapping_at_every_corner_give_the_outline_once(tmp_path):
-    from dataset.core.mesh import write_labelled_ply
-    from dataset.importers.mesh_import import import_labelled_mesh
+    from dataset.importers.mesh.mesh_import import import_labelled_mesh
+    from envelope.mesh import write_labelled_ply
 
     walls = _boxes(((0, 0, 0), (10, 0.3, 3)), ((0, 7.7, 0), (10, 8, 3)),
                    ((0, 0, 0), (0.3, 8, 3)), ((9.7, 0, 0), (10, 8, 3)), ((0, 0, 3), (10, 8, 3.2)))

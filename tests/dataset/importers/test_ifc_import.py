@@ -1,4 +1,4 @@
-"""dataset.importers.ifc_import: IFC houses made on the fly (tests/ifc_models.py) against their
+"""dataset.importers.ifc.convert: IFC houses made on the fly (tests/ifc_models.py) against their
 areas
 by hand; the same houses as one multi-body PLY; class overrides, skipped elements, CLI.
 
@@ -13,15 +13,15 @@ import pytest
 from shapely.geometry import Polygon
 
 from dataset import generate
-from dataset.core.classes import NO_FACADE, SemanticClass
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.mesh import write_labelled_ply
 from dataset.examples.ifc_houses import HOUSES, IfcHouse, box_house
-from dataset.importers.ifc_classes import read_class_overrides
-from dataset.importers.ifc_import import import_ifc, read_ifc, warning_lines
+from dataset.importers.ifc.classes import read_class_overrides
+from dataset.importers.ifc.convert import import_ifc, read_ifc, warning_lines
 from dataset.importers.import_config import ImportConfig
-from dataset.importers.mesh_import import import_labelled_mesh
-from dataset.rendering.raycast import Raycaster
+from dataset.importers.mesh.mesh_import import import_labelled_mesh
+from envelope.classes import NO_FACADE, SemanticClass
+from envelope.footprint import geojson_to_polygon
+from envelope.geometry.raycast import Raycaster
+from envelope.mesh import write_labelled_ply
 
 
 @pytest.fixture(scope="module")

@@ -1,11 +1,11 @@
-"""dataset.importers.ifc_mesh_export, and one building whichever way it comes in: each real IFC
+"""dataset.importers.ifc.mesh_export, and one building whichever way it comes in: each real IFC
 fixture (tests/fixtures/ifc_real, ArchiCAD / Revit / IfcOpenShell exports) imported as IFC and
 as the labelled mesh it exports (one body per element, interior walls, slabs and stairs
 included) gives the same window area, facade area and WWR.
 
 Bound: 3 % (issue 44). Measured (bench/ifc_mesh_agreement.py,
 docs/measurements/ifc-mesh-agreement.md): equal to 4 digits on all four; before the radial
-pairing of faces round shared edges (dataset.importers.edge_pairs) the FZK-Haus's mesh gave a
+pairing of faces round shared edges (dataset.importers.mesh.edge_pairs) the FZK-Haus's mesh gave a
 facade of 116 m² against 163 m² as IFC.
 """
 
@@ -18,11 +18,11 @@ import pytest
 from paths import FIXTURES
 
 from dataset.examples.ifc_houses import box_house
-from dataset.importers.ifc_import import building_from_ifc, read_ifc
-from dataset.importers.ifc_mesh_export import export_ifc_mesh, main, write_model_mesh
+from dataset.importers.ifc.convert import building_from_ifc, read_ifc
+from dataset.importers.ifc.mesh_export import export_ifc_mesh, main, write_model_mesh
 from dataset.importers.import_config import ImportConfig
-from dataset.importers.mesh_files import read_labelled_mesh_file
-from dataset.importers.mesh_import import import_labelled_mesh
+from dataset.importers.mesh.mesh_files import read_labelled_mesh_file
+from dataset.importers.mesh.mesh_import import import_labelled_mesh
 
 AGREEMENT = 0.03
 

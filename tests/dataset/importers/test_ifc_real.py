@@ -1,8 +1,8 @@
-"""dataset.importers.ifc_import on real exports: ArchiCAD 20 (IFC4), Revit 2011 and 2021
+"""dataset.importers.ifc.convert on real exports: ArchiCAD 20 (IFC4), Revit 2011 and 2021
 (IFC2X3), IfcOpenShell (IFC4) -- tests/fixtures/ifc_real/SOURCE.md.
 
 Each model is checked against measures the importer does not use
-(:mod:`dataset.importers.ifc_checks`): its windows' declared OverallWidth x OverallHeight, the
+(:mod:`dataset.importers.ifc.checks`): its windows' declared OverallWidth x OverallHeight, the
 facade and WWR on orthographic elevations, and the plan projection of the elements standing
 at the footprint height. The values measured (bench/ifc_corpus.py prints the same) are in each
 test's docstring; the bounds are the issue's (windows within 5 % of the declared sizes) and,
@@ -17,10 +17,10 @@ import numpy as np
 import pytest
 from paths import FIXTURES
 
-from dataset.core.classes import NO_FACADE, SemanticClass
-from dataset.importers.ifc_checks import elevation_areas, footprint_iou, plan_footprint
-from dataset.importers.ifc_import import building_from_ifc, read_ifc
+from dataset.importers.ifc.checks import elevation_areas, footprint_iou, plan_footprint
+from dataset.importers.ifc.convert import building_from_ifc, read_ifc
 from dataset.importers.import_config import ImportConfig
+from envelope.classes import NO_FACADE, SemanticClass
 
 FIXTURES = FIXTURES / "ifc_real"
 

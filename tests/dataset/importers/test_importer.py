@@ -12,9 +12,6 @@ import trimesh
 from paths import REPO_ROOT
 from shapely.geometry import Polygon
 
-from dataset.core.classes import SemanticClass
-from dataset.core.footprint import geojson_to_polygon
-from dataset.core.mesh import LabelledMesh, write_labelled_ply
 from dataset.examples.make_example_bim import (
     DOOR,
     WALL,
@@ -23,8 +20,11 @@ from dataset.examples.make_example_bim import (
     example_bim_boxes,
     write_labelled_obj,
 )
-from dataset.importers.mesh_import import ImportConfig, import_labelled_mesh
+from dataset.importers.mesh.mesh_import import ImportConfig, import_labelled_mesh
 from dataset.presets import build_building, preset_recipes
+from envelope.classes import SemanticClass
+from envelope.footprint import geojson_to_polygon
+from envelope.mesh import LabelledMesh, write_labelled_ply
 
 REL = 1e-6
 EXAMPLES = REPO_ROOT / "dataset" / "examples"

@@ -1,10 +1,14 @@
-"""dataset.importers.mesh_files: class names, vertex merging, OBJ parsing."""
+"""dataset.importers.mesh.mesh_files: class names, vertex merging, OBJ parsing."""
 
 import numpy as np
 import pytest
 
-from dataset.core.classes import SemanticClass
-from dataset.importers.mesh_files import class_from_name, merge_vertices, read_labelled_mesh_file
+from dataset.importers.mesh.mesh_files import (
+    class_from_name,
+    merge_vertices,
+    read_labelled_mesh_file,
+)
+from envelope.classes import SemanticClass
 
 
 @pytest.mark.parametrize("name, expected", [

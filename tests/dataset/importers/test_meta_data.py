@@ -1,4 +1,5 @@
-"""dataset.importers.meta_data: meta_data.json round trips, OpenGL <-> OpenCV poses, class
+"""dataset.importers.buildnet3d.meta_data: meta_data.json round trips, OpenGL <-> OpenCV poses,
+class
 remapping."""
 
 import json
@@ -8,10 +9,7 @@ import numpy as np
 import pytest
 from paths import REPO_ROOT
 
-from dataset.core.camera import Intrinsics, look_at, project_world_to_image
-from dataset.core.classes import SemanticClass
-from dataset.core.scene_record import Frame, Scene
-from dataset.importers.meta_data import (
+from dataset.importers.buildnet3d.meta_data import (
     BUILDNET3D_LAYOUT,
     SDFSTUDIO_LAYOUT,
     class_mapping,
@@ -21,7 +19,10 @@ from dataset.importers.meta_data import (
     remap_labels,
     write_meta_data,
 )
-from dataset.scenes.scene import read_scene, write_transforms
+from envelope.camera import Intrinsics, look_at, project_world_to_image
+from envelope.classes import SemanticClass
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.scene import read_scene, write_transforms
 
 K = Intrinsics(40.0, 42.0, 16.5, 12.25, 32, 24)
 
@@ -157,7 +158,7 @@ def test_remap_colour_coded_masks():
 
 
 def test_scene_box_around_the_building_and_partial_boxes_completed(tmp_path):
-    from dataset.importers.mesh_import import import_labelled_mesh
+    from dataset.importers.mesh.mesh_import import import_labelled_mesh
 
     example = REPO_ROOT / "dataset" / "examples" / "example_bim.ply"
     truth = import_labelled_mesh(example).truth

@@ -9,7 +9,7 @@ import pytest
 from paths import FIXTURES
 from scipy.integrate import quad
 
-from dataset.importers.opendrive import (
+from dataset.importers.opendrive.read import (
     Geometry,
     OpenDriveError,
     geometry_xy,
@@ -18,7 +18,7 @@ from dataset.importers.opendrive import (
     reference_points,
     spiral_xy,
 )
-from dataset.importers.opendrive_streets import streets_in_frame
+from dataset.importers.opendrive.streets import streets_in_frame
 
 ROAD = FIXTURES / "opendrive" / "ingolstadt_road_1444000.xodr.xz"
 ROAD_OFFSET = FIXTURES / "opendrive" / "ingolstadt_road_1444000_offset.xodr.xz"

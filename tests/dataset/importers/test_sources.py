@@ -13,16 +13,15 @@ import pytest
 from conftest import make_box_building
 from paths import FIXTURES, REPO_ROOT
 
-import dataset.importers.building_file as building_file
+import dataset.importers.mesh.building_file as building_file
 from dataset import generate, importer
-from dataset.core.truth import Building, read_building
 from dataset.examples.ifc_houses import box_house
-from dataset.importers.blenderproc import BLENDERPROC_SOURCE
-from dataset.importers.building_file import IFC_SOURCE, MESH_SOURCE, BuildingFileOptions
-from dataset.importers.buildnet3d import BUILDNET3D_SOURCE
-from dataset.importers.citygml_source import CITYGML_SOURCE
+from dataset.importers.buildnet3d.blenderproc import BLENDERPROC_SOURCE
+from dataset.importers.buildnet3d.buildnet3d import BUILDNET3D_SOURCE
+from dataset.importers.citygml.source import CITYGML_SOURCE
 from dataset.importers.import_config import ImportConfig
-from dataset.importers.mesh_import import import_labelled_mesh
+from dataset.importers.mesh.building_file import IFC_SOURCE, MESH_SOURCE, BuildingFileOptions
+from dataset.importers.mesh.mesh_import import import_labelled_mesh
 from dataset.importers.source import (
     BuildingEntry,
     NoOptions,
@@ -31,9 +30,10 @@ from dataset.importers.source import (
     pick_source,
     write_scenes,
 )
-from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import GenerateConfig, scene_changes
 from dataset.sources import PRESET_SOURCE, SOURCES
+from envelope.scenes.scene import read_scene
+from envelope.truth import Building, read_building
 
 EXAMPLE = REPO_ROOT / "dataset" / "examples" / "example_bim.ply"
 SMALL = GenerateConfig(resolution=32, views=4)

@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.core.camera import Intrinsics, look_at, project_world_to_image
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh, concatenate_meshes
-from dataset.core.truth import Building
 from dataset.rendering.facade_views import FacadeViewConfig, ideal_views, multi_views
 from dataset.rendering.orbit_views import OrbitConfig, orbit_view_failures, sample_orbit_views
 from dataset.rendering.render import Raycaster, render_ground_truth
+from envelope.camera import Intrinsics, look_at, project_world_to_image
+from envelope.classes import SemanticClass
+from envelope.mesh import LabelledMesh, concatenate_meshes
+from envelope.truth import Building
 
 K = Intrinsics.from_fov(128, 128, 60.0)
 

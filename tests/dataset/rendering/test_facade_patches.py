@@ -5,10 +5,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh
-from dataset.core.truth import Building
 from dataset.rendering.facade_patches import facade_patches
+from envelope.classes import SemanticClass
+from envelope.mesh import LabelledMesh
+from envelope.truth import Building
 
 
 def test_box_facades_have_exact_geometry(box_building):

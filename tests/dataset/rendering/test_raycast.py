@@ -1,4 +1,4 @@
-"""dataset.rendering.raycast: the one ray caster and its inside rule (winding numbers).
+"""envelope.geometry.raycast: the one ray caster and its inside rule (winding numbers).
 
 Rendering, visibility, sections and camera checks all cast through :class:`Raycaster`; on a
 thin wall with a window opening, made of four touching boxes, they see the same hits and
@@ -10,13 +10,13 @@ import pytest
 import trimesh
 from shapely.geometry import Point
 
-from dataset.core.camera import Intrinsics, look_at, rays_world
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh
-from dataset.rendering.raycast import Raycaster, winding_numbers
 from dataset.rendering.render import render_ground_truth
 from dataset.rendering.section import cross_section_footprint
-from dataset.rendering.visibility import escape_fractions
+from envelope.camera import Intrinsics, look_at, rays_world
+from envelope.classes import SemanticClass
+from envelope.geometry.raycast import Raycaster, winding_numbers
+from envelope.geometry.visibility import escape_fractions
+from envelope.mesh import LabelledMesh
 
 
 def _boxes(*bounds) -> LabelledMesh:

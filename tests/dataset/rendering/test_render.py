@@ -6,15 +6,6 @@ import numpy as np
 import pytest
 import trimesh
 
-from dataset.core.camera import (
-    Intrinsics,
-    look_at,
-    pixel_centres,
-    rays_world,
-    unproject_depth_to_world,
-)
-from dataset.core.classes import SemanticClass
-from dataset.core.mesh import LabelledMesh, concatenate_meshes
 from dataset.rendering.render import (
     Raycaster,
     RgbConfig,
@@ -23,6 +14,15 @@ from dataset.rendering.render import (
     render_view,
 )
 from dataset.rendering.shading import sample_look
+from envelope.camera import (
+    Intrinsics,
+    look_at,
+    pixel_centres,
+    rays_world,
+    unproject_depth_to_world,
+)
+from envelope.classes import SemanticClass
+from envelope.mesh import LabelledMesh, concatenate_meshes
 
 K = Intrinsics.from_fov(160, 120, 60.0)
 # Oblique view of the box's -y and -x facades and its roof (generic: no pixel ray

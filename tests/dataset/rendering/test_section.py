@@ -5,8 +5,8 @@ import pytest
 import trimesh
 from shapely.geometry import Polygon
 
-from dataset.rendering.raycast import Raycaster
 from dataset.rendering.section import cross_section_footprint
+from envelope.geometry.raycast import Raycaster
 
 
 def _footprint(mesh, z):

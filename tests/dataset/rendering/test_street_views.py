@@ -13,9 +13,6 @@ import shapely
 from conftest import assert_complete_scene, make_box_building
 from shapely.geometry import Polygon, box
 
-from dataset.core.mesh import LabelledMesh
-from dataset.core.neighbours import Neighbour, Street
-from dataset.rendering.raycast import Raycaster
 from dataset.rendering.street_views import (
     StreetConfig,
     street_pose,
@@ -23,6 +20,9 @@ from dataset.rendering.street_views import (
     street_views,
 )
 from dataset.scenes.scene_writer import GenerateConfig, generate_scene, plan_views
+from envelope.geometry.raycast import Raycaster
+from envelope.mesh import LabelledMesh
+from envelope.neighbours import Neighbour, Street
 
 BOX_XY = box(-10.0, -6.0, 10.0, 6.0)  # conftest's box building seen from above
 PITCH = np.radians(20.0)
@@ -122,7 +122,7 @@ def test_scene_with_street_frames(tmp_path):
 
 @pytest.fixture(scope="module")
 def lod3_building():
-    from dataset.importers.citygml_preset import build_lod3_building, lod3_entries
+    from dataset.importers.citygml.preset import build_lod3_building, lod3_entries
 
     entry = next(e for e in lod3_entries() if e.id == "4018106")
     return build_lod3_building(entry.id, entry.file)
@@ -156,9 +156,9 @@ def test_street_cameras_do_not_read_the_truth(lod3_building):
 def test_committed_roads_run_between_the_buildings():
     """The lanes of the committed OpenDRIVE file, mapped as the buildings are, cross no
     building's ground surface and pass within 30 m of every scene building."""
-    from dataset.importers.citygml_preset import ROAD_NETWORK, lod3_entries, lod3_files
-    from dataset.importers.citygml_read import read_citygml
-    from dataset.importers.opendrive_streets import streets_in_frame
+    from dataset.importers.citygml.preset import ROAD_NETWORK, lod3_entries, lod3_files
+    from dataset.importers.citygml.read import read_citygml
+    from dataset.importers.opendrive.streets import streets_in_frame
 
     lanes = shapely.MultiLineString([s.points_m[:, :2] for s in streets_in_frame(
         ROAD_NETWORK, "EPSG:32632", (0.0, 0.0, 0.0))])

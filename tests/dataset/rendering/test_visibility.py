@@ -1,11 +1,11 @@
-"""dataset.rendering.visibility: ray directions, escape fractions on convex and nested boxes."""
+"""envelope.geometry.visibility: ray directions, escape fractions on convex and nested boxes."""
 
 import numpy as np
 import pytest
 import trimesh
 
-from dataset.rendering.raycast import Raycaster
-from dataset.rendering.visibility import MIN_RAY_COSINE, escape_fractions, hemisphere_directions
+from envelope.geometry.raycast import Raycaster
+from envelope.geometry.visibility import MIN_RAY_COSINE, escape_fractions, hemisphere_directions
 
 
 def _normals(tri):

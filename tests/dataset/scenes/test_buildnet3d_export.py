@@ -15,10 +15,10 @@ from neural3d_scene import write_ring_scene
 from PIL import Image
 
 from dataset.buildnet3d_export import main as export_main
-from dataset.core.classes import CLASS_NAMES
-from dataset.scenes.images import read_rgb
-from dataset.scenes.scene import read_scene
-from dataset.scenes.scene_validation import read_frame_depth_m, read_frame_labels
+from envelope.classes import CLASS_NAMES
+from envelope.scenes.images import read_rgb
+from envelope.scenes.scene import read_scene
+from envelope.scenes.scene_validation import read_frame_depth_m, read_frame_labels
 
 
 def read_like_buildnet_dataparser(root: Path) -> dict:

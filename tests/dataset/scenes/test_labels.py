@@ -1,4 +1,4 @@
-"""dataset.scenes.labels: every method reads a frame's labels in our ids, whatever the scene
+"""envelope.scenes.labels: every method reads a frame's labels in our ids, whatever the scene
 holds."""
 
 from __future__ import annotations
@@ -8,12 +8,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from dataset.core.camera import Intrinsics
-from dataset.core.classes import SemanticClass
-from dataset.core.scene_record import Frame, Scene
-from dataset.scenes.images import write_labels
-from dataset.scenes.labels import class_mapping, mapping_for_classes
-from dataset.scenes.scene_validation import read_frame_labels
+from envelope.camera import Intrinsics
+from envelope.classes import SemanticClass
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.images import write_labels
+from envelope.scenes.labels import class_mapping, mapping_for_classes
+from envelope.scenes.scene_validation import read_frame_labels
 
 
 def _scene(tmp_path, labels, classes):

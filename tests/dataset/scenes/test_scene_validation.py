@@ -1,11 +1,11 @@
-"""dataset.scenes.scene_validation: pose tolerance, paths inside the folder, warning kinds."""
+"""envelope.scenes.scene_validation: pose tolerance, paths inside the folder, warning kinds."""
 
 import numpy as np
 import pytest
 
-from dataset.core.camera import look_at
-from dataset.core.warnings_summary import warning_kind
-from dataset.scenes.scene_validation import ROTATION_TOLERANCE, pose_problem, resolve_inside
+from envelope.camera import look_at
+from envelope.scenes.scene_validation import ROTATION_TOLERANCE, pose_problem, resolve_inside
+from envelope.warnings_summary import warning_kind
 
 
 def test_a_float32_round_trip_pose_is_proper_and_a_scaled_one_is_not():

@@ -8,17 +8,23 @@ import pytest
 from conftest import assert_complete_scene, make_box_building
 
 import dataset.scenes.scene_writer as scene_writer
-from dataset.core.camera import look_at
-from dataset.core.mesh import read_labelled_ply
 from dataset.rendering.render import Raycaster, render_ground_truth
-from dataset.scenes.images import read_depth_m, read_facade_ids, read_labels, read_normals, read_rgb
-from dataset.scenes.scene import read_scene
 from dataset.scenes.scene_writer import (
     GenerateConfig,
     depth_unit_for,
     generate_scene,
     scene_is_finished,
 )
+from envelope.camera import look_at
+from envelope.mesh import read_labelled_ply
+from envelope.scenes.images import (
+    read_depth_m,
+    read_facade_ids,
+    read_labels,
+    read_normals,
+    read_rgb,
+)
+from envelope.scenes.scene import read_scene
 
 SMALL = GenerateConfig(resolution=40, views=6)
 

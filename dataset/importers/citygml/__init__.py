@@ -1,0 +1,1 @@
+"""CityGML LoD3 city models: reading, facades, context, the lod3 preset."""

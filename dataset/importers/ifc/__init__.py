@@ -1,0 +1,1 @@
+"""IFC models through IfcOpenShell, and their export as labelled meshes."""

@@ -1,0 +1,1 @@
+"""Labelled meshes: reading, validation, ground, contacts, facade grouping."""

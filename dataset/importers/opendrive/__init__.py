@@ -1,0 +1,1 @@
+"""OpenDRIVE road networks: the streets a street capture drives along."""

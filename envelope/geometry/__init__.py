@@ -1,0 +1,1 @@
+"""Ray casting and visibility against a triangle mesh."""

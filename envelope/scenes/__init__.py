@@ -1,0 +1,1 @@
+"""Reading and validating scene folders (transforms.json, images, labels)."""

@@ -1,0 +1,1 @@
+"""Exports for energy tools (CSV, IDF geometry, CityJSON): python -m metrics.export."""

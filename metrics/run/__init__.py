@@ -1,0 +1,1 @@
+"""Running methods on scenes: options, caches, executors, masks and degradations."""

@@ -1,0 +1,57 @@
+"""Comparisons on degraded inputs (``python -m metrics.compare --degrade NAME[:SEVERITY],...``).
+
+The scenes are degraded once into a cache folder next to the results
+(``<data>-degraded/<key>/<scene>``, see :mod:`dataset.degrade.scene_copy`);
+methods run on that copy unchanged, their results go to
+``<results>/degraded/<key>`` and carry the specs in their config under
+``degradation`` (so a result made under other specs is never reused); the
+truth is the original's (the copy's ``building.json`` is a hard link to it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from tqdm import tqdm
+
+from dataset.degrade.scene_copy import degrade_scene
+from dataset.degrade.spec import DegradeSpec, specs_key
+from metrics.run.runner import MethodSpec, find_scenes
+
+CONFIG_KEY = "degradation"
+
+
+@dataclass(frozen=True)
+class DegradedRun:
+    """Where a comparison under ``specs`` reads scenes and writes results and outputs."""
+
+    data: Path
+    results: Path
+    out: Path
+
+
+def degraded_run(data: Path, results: Path, out: Path,
+                 specs: tuple[DegradeSpec, ...]) -> DegradedRun:
+    """Degrade every scene of ``data`` (reusing finished copies) and name the folders."""
+    key = specs_key(specs)
+    cache = data.with_name(f"{data.name}-degraded") / key
+    scenes = [d for d in find_scenes(data) if (d / "transforms.json").is_file()]
+    for scene_dir in tqdm(scenes, desc=f"degrade {key}", unit="scene", leave=False):
+        degrade_scene(scene_dir, cache, specs)
+    return DegradedRun(cache, results / "degraded" / key, out.with_name(f"{out.name}-{key}"))
+
+
+def with_degradation(specs: Sequence[MethodSpec],
+                     degradation: tuple[DegradeSpec, ...]) -> list[MethodSpec]:
+    """The same methods, their requested and written configs carrying the specs."""
+    record = [s.to_json() for s in degradation]
+
+    def wrap(run):
+        def degraded(scene_dir: Path, protocol: str):
+            result = run(scene_dir, protocol)
+            return replace(result, config={**result.config, CONFIG_KEY: record})
+        return degraded
+
+    return [replace(s, config={**s.config, CONFIG_KEY: record}, run=wrap(s.run)) for s in specs]

@@ -1,0 +1,154 @@
+"""The methods the comparison runs, all through :class:`envelope.method.Method`.
+
+The built-in ones are found where :data:`envelope.method.BUILT_IN` says
+they are declared; any other name is looked up among the installed plugins
+(entry point group ``envelope_bench.methods``). Each becomes a
+:class:`~metrics.run.runner.MethodSpec` whose ``run`` reads a scene folder as the
+method's :class:`~envelope.method_input.MethodInput` (no truth: metrics alone
+reads ``building.json``) and returns the method's result. A built-in
+method whose package cannot be imported still gets a spec: its runs fail with
+the import error as the reason, and the other methods go on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import fields, is_dataclass, replace
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+from envelope.executors.ray_tasks import TaskResources
+from envelope.method import BUILT_IN, Method, built_in_method, installed_methods
+from envelope.protocols import SELECTABLE_PROTOCOLS
+from envelope.results import MethodResult
+from envelope.scenes.scene import read_method_input
+from metrics.run.runner import MethodSpec
+
+METHODS: tuple[str, ...] = tuple(BUILT_IN)
+
+
+def method_specs(
+    names: tuple[str, ...],
+    views: tuple[str, ...],
+    results_dir: Path,
+    *,
+    configs: Mapping[str, Any] | None = None,
+    seeds: tuple[int, ...] = (0,),
+) -> list[MethodSpec]:
+    """Specs of the named methods, each run with ``configs[name]`` (default: its config
+    type's default instance); view methods run on ``views``. A method whose config has a
+    ``seed`` field (neural3d: the training seed) gets one spec per seed of ``seeds``.
+
+    Raises
+    ------
+    ValueError
+        If a method name or a views protocol is unknown.
+    """
+    plugins = _check_names(names, views)
+    configs = configs or {}
+    specs = []
+    for name in names:
+        try:
+            method = built_in_method(name) if name in BUILT_IN else plugins[name]
+        except ImportError as exc:
+            specs.append(_unavailable(name, views, exc))
+            continue
+        config = configs.get(name)
+        config = method.config_type() if config is None else config
+        if _has_seed(config):
+            specs += [spec_from_method(method, views, results_dir, replace(config, seed=s))
+                      for s in seeds]
+        else:
+            specs.append(spec_from_method(method, views, results_dir, config))
+    return specs
+
+
+def _has_seed(config: Any) -> bool:
+    return is_dataclass(config) and any(f.name == "seed" for f in fields(config))
+
+
+def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
+                     config: Any = None) -> MethodSpec:
+    """The spec of ``method`` run with ``config`` (``None``: its config type's default).
+
+    It runs on the protocols it declares: of the selectable ones (ideal, multi, street), those
+    in ``views``; others (``train``) always. A method with an ``artefacts`` folder
+    keeps it under ``results_dir`` (a seed other than 0 in ``seed<k>/`` below it).
+    """
+    config = method.config_type() if config is None else config
+    protocols = tuple(p for p in method.protocols if p not in SELECTABLE_PROTOCOLS or p in views)
+    seed = config.seed if _has_seed(config) else None
+    artefacts_dir = results_dir / method.artefacts if method.artefacts else None
+    if artefacts_dir is not None and seed:
+        artefacts_dir = artefacts_dir / f"seed{seed}"
+    run = partial(_run_on_folder, method, config)
+    if artefacts_dir is not None:
+        run = partial(run, artefacts_dir=artefacts_dir)
+    cpus, gpus = method.cpus_gpus(config)
+    debug_images = None if method.debug_images is None else partial(
+        _debug_images_of_folder, method, config)
+    return MethodSpec(method.name, protocols, method.config_record(config), run,
+                      has_footprint=method.has_footprint,
+                      resources=TaskResources(cpus=cpus, gpus=gpus),
+                      artefacts_dir=artefacts_dir, code=("envelope", *method.packages),
+                      libraries=method.libraries, mesh_file=method.mesh_file,
+                      heavy=method.heavy, debug_images=debug_images, seed=seed,
+                      paper_name=method.paper_name)
+
+
+def _run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
+                   **artefacts_dir: Path) -> MethodResult:
+    return method.run(read_method_input(scene_dir, method.inputs), protocol, config,
+                      **artefacts_dir)
+
+
+def _debug_images_of_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
+                            folder: Path) -> None:
+    assert method.debug_images is not None
+    method.debug_images(read_method_input(scene_dir, method.inputs), protocol, config, folder)
+
+
+def list_methods() -> list[str]:
+    """One line per available method: name, where it comes from, inputs, protocols, resources."""
+    lines = []
+    found = {name: "built-in" for name in METHODS}
+    plugins = installed_methods()
+    found.update({name: "plugin" for name in plugins if name not in BUILT_IN})
+    for name, origin in found.items():
+        try:
+            m = built_in_method(name) if origin == "built-in" else plugins[name]
+        except ImportError as exc:
+            lines.append(f"{name:10s} {origin:10s} not available: {exc}")
+            continue
+        lines.append(f"{name:10s} {origin:10s} inputs {','.join(m.inputs)}; protocols "
+                     f"{','.join(m.protocols)}; {m.resources}"
+                     + (f"; {m.description}" if m.description else ""))
+    return lines
+
+
+def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> dict[str, Method]:
+    """Check the names and views; returns the installed plugins (loaded only when needed)."""
+    if not names:
+        raise ValueError(f"no method given; choose from {', '.join(METHODS)}")
+    for view in views:
+        if view not in SELECTABLE_PROTOCOLS:
+            raise ValueError(f"unknown views {view!r}; choose from "
+                             f"{', '.join(SELECTABLE_PROTOCOLS)}")
+    plugins = installed_methods() if any(n not in METHODS for n in names) else {}
+    for name in names:
+        if name not in METHODS and name not in plugins:
+            known = ", ".join((*METHODS, *sorted(plugins)))
+            raise ValueError(f"unknown method {name!r}; choose from {known} "
+                             "(`--list-methods` lists the installed ones)")
+    return plugins
+
+
+def _unavailable(name: str, protocols: tuple[str, ...], exc: ImportError) -> MethodSpec:
+    reason = f"method {name} is not available: {exc}"
+
+    def run(scene_dir: Path, protocol: str, **_: Any):
+        raise RuntimeError(reason)
+
+    # An empty config matches any stored result, so earlier results are still used.
+    return MethodSpec(name, protocols, {}, run)

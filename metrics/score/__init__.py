@@ -1,0 +1,1 @@
+"""Error measures: facade matching, per-building errors, aggregation, bootstrap."""
