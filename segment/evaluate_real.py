@@ -37,14 +37,13 @@ from segment.real_measure import (
     split_scores,
     wwr_scores,
 )
-from segment.real_sets import SET_NAMES, RealPhoto, cmp, labelmefacade, read_set
+from segment.real_sets import SET_NAMES, SOURCES, RealPhoto, cmp, read_set
 from segment.real_sets.common import PHOTO_SPLITS, PHOTO_TEST, PHOTO_TRAIN, PHOTO_VAL
 from segment.real_sets.splits import committed_splits, split_of
 from segment.segmenter import Segmenter, resolve_segmenter
 
 REPORT_SPLITS = (PHOTO_TEST, PHOTO_VAL, PHOTO_TRAIN)
 """Order of the splits in the report."""
-_SOURCES = {labelmefacade.SET_NAME: labelmefacade.SOURCE, cmp.SET_NAME: cmp.SOURCE}
 
 
 def evaluate_set(photos: Sequence[RealPhoto], segmenter: Segmenter,
@@ -85,7 +84,7 @@ def report_markdown(results: dict[str, dict[str, list[PhotoResult]]], segmenter:
         "| set | copy read (source, commit) | licence |", "|---|---|---|",
     ]
     for name in results:
-        src = _SOURCES[name]
+        src = SOURCES[name]
         lines.append(f"| {name} | {roots[name].name}/ ({src['repository']}, "
                      f"`{src['commit'][:12]}`) | {src['licence']} |")
     lines += ["", "## Window masks per split", "",

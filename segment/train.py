@@ -35,7 +35,7 @@ from envelope.provenance import file_fingerprint, make_provenance
 from segment.augment import IGNORE_LABEL, REAL_PHOTO_AUGMENT, AugmentConfig
 from segment.evaluate import confusion_matrix, evenly_spaced, iou_per_class, mean_iou
 from segment.network import UNet, UNetConfig
-from segment.real_sets import SET_NAMES
+from segment.real_sets import SET_NAMES, SOURCES
 from segment.real_sets.splits import LIST_DIR
 from segment.real_training import RealSource, real_sources
 from segment.segmenter import predict_labels
@@ -143,6 +143,7 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
                  "cpu_time_s": round(time.process_time() - cpu_start, 3)}
         record = _record(config, [*train, *real_train], [*val, *real_val], weights, best,
                          history, steps_run, times)
+        record["training_sets"] = training_sets(real or {})
         record["provenance"] = provenance.to_json_dict()
         save_weights(out, model, record)
         return record
@@ -237,6 +238,19 @@ def _validate(model: UNet, val: Sequence[TrainingScene | RealSource], frames: in
 def _or_none(value: float) -> float | None:
     """A JSON-ready IoU: ``None`` for a class absent from every validation scene."""
     return None if np.isnan(value) else float(value)
+
+
+RENDERS_SOURCE = {
+    "repository": "this project's procedural renders (the segtrain preset, dataset.presets)",
+    "licence": "MIT (the project's own)",
+}
+"""What the render scenes a segmenter trains on are, for its record."""
+
+
+def training_sets(real: Mapping[str, Path]) -> dict[str, dict[str, str]]:
+    """Every set a training reads, with its source and licence: the renders, and each real
+    set of ``real`` (set name -> folder; :data:`segment.real_sets.SOURCES`)."""
+    return {"renders": dict(RENDERS_SOURCE), **{n: dict(SOURCES[n]) for n in sorted(real)}}
 
 
 def _record(config: TrainConfig, train: Sequence[TrainingScene | RealSource],

@@ -17,7 +17,7 @@ import numpy as np
 from segment.real_sets import cmp, labelmefacade
 from segment.real_sets.common import IGNORED, RealPhoto, read_labelled
 
-__all__ = ["IGNORED", "RealPhoto", "SET_NAMES", "read_set", "read_photo_pair"]
+__all__ = ["IGNORED", "RealPhoto", "SET_NAMES", "SOURCES", "read_set", "read_photo_pair"]
 
 _READERS: dict[str, tuple[Callable[[Path], list[RealPhoto]], Callable[[Path], np.ndarray]]] = {
     labelmefacade.SET_NAME: (labelmefacade.labelmefacade_photos,
@@ -26,6 +26,9 @@ _READERS: dict[str, tuple[Callable[[Path], list[RealPhoto]], Callable[[Path], np
 }
 SET_NAMES = tuple(_READERS)
 """The sets read here: ``labelmefacade``, ``cmp``."""
+SOURCES: dict[str, dict[str, str]] = {labelmefacade.SET_NAME: labelmefacade.SOURCE,
+                                      cmp.SET_NAME: cmp.SOURCE}
+"""Each set's repository, commit and licence (recorded with weights trained on it)."""
 
 
 def read_set(set_name: str, root: str | Path) -> list[RealPhoto]:

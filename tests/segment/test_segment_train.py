@@ -68,6 +68,7 @@ def test_a_few_steps_write_weights_with_their_record(trained, clean_scene):
     assert record["steps_run"] == 3 and not record["cut_short"]
     assert [s["scene"] for s in record["trained_on"]] == [clean_scene.name]
     assert record["trained_on"][0]["preset"] is None and record["validated_on"] == []
+    assert list(record["training_sets"]) == ["renders"]
     assert record["config"]["network"] == {"base_channels": 4, "levels": 3, "num_classes": 6}
     assert len(record["class_weights"]) == len(CLASS_NAMES)
     assert record["provenance"]["config"]["seed"] == 0

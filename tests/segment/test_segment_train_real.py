@@ -67,6 +67,10 @@ def test_a_few_steps_on_renders_and_real_photos(clean_scene, tmp_path):
     assert named and not named & _test_names()
     assert record["steps_run"] == 3 and "val_window_iou" in record["history"][-1]
     assert set(record["provenance"]["inputs"]["real_split_lists"]) == {"labelmefacade", "cmp"}
+    sets = record["training_sets"]  # every set it read, with its licence
+    assert list(sets) == ["renders", "cmp", "labelmefacade"]
+    assert sets["labelmefacade"]["licence"].startswith("non-commercial research use only")
+    assert all(s["licence"] and s["repository"] for s in sets.values())
     load_network(out)
     with pytest.raises(ValueError, match="picked on real validation photos"):
         validation_scenes(record, [clean_scene])  # not calibrated on renders
