@@ -33,7 +33,7 @@ from segment.evaluate import evenly_spaced
 from segment.network import UNet
 from segment.segmenter import predict_logits
 from segment.training_data import TrainingScene, load_training_scenes
-from segment.weights import DEFAULT_WEIGHTS, load_network, save_weights
+from segment.weights import RENDER_WEIGHTS, load_network, save_weights
 
 MARGIN_EDGES = np.linspace(-40.0, 40.0, 3201)
 """Histogram bin edges of the window logit margin (0.025 wide; margins beyond are clipped)."""
@@ -157,8 +157,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         "data/segtrain-512. Details: docs/segment.md.")
     parser.add_argument("--data", type=Path, action="append", required=True,
                         help="a folder holding the validation buildings (repeat for several)")
-    parser.add_argument("--weights", type=Path, default=DEFAULT_WEIGHTS,
-                        help="weights file to calibrate (default: the committed weights)")
+    parser.add_argument("--weights", type=Path, default=RENDER_WEIGHTS,
+                        help="weights file to calibrate (default: the committed render-trained "
+                        "weights; weights picked on real photos are refused)")
     parser.add_argument("--out", type=Path, default=None,
                         help="where to write the calibrated weights (default: --weights)")
     parser.add_argument("--frames", type=int, default=24,

@@ -28,11 +28,12 @@ from envelope.classes import CLASS_NAMES, NUM_CLASSES
 from envelope.provenance import code_fingerprint, file_fingerprint, library_version
 from segment.network import UNet
 from segment.photo_io import read_photo_rgb
-from segment.weights import DEFAULT_WEIGHTS, load_network
+from segment.weights import BUILT_IN_WEIGHTS, DEFAULT_WEIGHTS, load_network
 
 ENTRY_POINT_GROUP = "envelope_bench.segmenters"
 DEFAULT_NAME = "default"
-"""Name of the built-in network with the committed weights (:data:`DEFAULT_WEIGHTS`)."""
+"""What names the default weights (:data:`segment.weights.DEFAULT_WEIGHTS`) besides their own
+name in :data:`segment.weights.BUILT_IN_WEIGHTS`."""
 SegmentFn = Callable[[np.ndarray], np.ndarray]
 """``rgb (H, W, 3) uint8 -> labels (H, W) uint8``, ids in ``0 .. NUM_CLASSES - 1``."""
 
@@ -63,7 +64,8 @@ def network_segmenter(weights: str | Path = DEFAULT_WEIGHTS, *, threads: int = 2
     offsets = calibrated_offsets(record, weights)
     identity = {"weights": file_fingerprint(weights), "code": code_fingerprint("segment"),
                 "torch": library_version("torch")}
-    label = name or (DEFAULT_NAME if Path(weights) == DEFAULT_WEIGHTS else str(weights))
+    built_in = {path: n for n, path in BUILT_IN_WEIGHTS.items()}
+    label = name or built_in.get(Path(weights), str(weights))
 
     def segment(rgb: np.ndarray) -> np.ndarray:
         return predict_labels(model, rgb, threads=threads, logit_offsets=offsets)
@@ -120,8 +122,9 @@ def installed_segmenters() -> dict[str, EntryPoint]:
 
 
 def resolve_segmenter(model: str | None = None, *, threads: int = 2) -> Segmenter:
-    """The segmenter that ``model`` names: ``None`` or ``"default"`` (the committed
-    weights), a weights file (``*.pt``) or an installed plugin's entry-point name.
+    """The segmenter that ``model`` names: ``None`` or ``"default"`` (the default committed
+    weights), a committed weights name (:data:`segment.weights.BUILT_IN_WEIGHTS`), a weights
+    file (``*.pt``) or an installed plugin's entry-point name.
 
     Raises
     ------
@@ -131,14 +134,16 @@ def resolve_segmenter(model: str | None = None, *, threads: int = 2) -> Segmente
     """
     if model is None or model == DEFAULT_NAME:
         return network_segmenter(DEFAULT_WEIGHTS, threads=threads)
+    if model in BUILT_IN_WEIGHTS:
+        return network_segmenter(BUILT_IN_WEIGHTS[model], threads=threads)
     plugins = installed_segmenters()
     if model in plugins:
         return _plugin(plugins[model])
     if model.endswith(".pt") or Path(model).is_file():
         return network_segmenter(model, threads=threads)
-    known = ", ".join([DEFAULT_NAME, *plugins]) or DEFAULT_NAME
+    known = ", ".join([DEFAULT_NAME, *BUILT_IN_WEIGHTS, *plugins])
     raise ValueError(f"unknown segmenter {model!r}: give a weights file (*.pt), "
-                     f"{DEFAULT_NAME!r} or an installed plugin ({known})")
+                     f"a committed name or an installed plugin ({known})")
 
 
 def segment_rgb(segmenter: Segmenter, rgb: np.ndarray) -> np.ndarray:

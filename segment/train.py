@@ -285,7 +285,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "its weights with their training record. Scenes of an evaluated preset are refused.",
         epilog="example: python -m dataset.generate --preset segtrain --out data/segtrain-512 "
         "--views 40 && python -m segment.train --data data/segtrain-512 --out "
-        "segment/weights/default.pt. Details: docs/segment.md.",
+        "segment/weights/renders.pt. Details: docs/segment.md.",
     )
     parser.add_argument("--data", type=Path, action="append", required=True,
                         help="a folder of training scenes (repeat for several, e.g. the same "

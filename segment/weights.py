@@ -27,8 +27,21 @@ from envelope.classes import CLASS_NAMES
 from segment.network import UNet, UNetConfig
 
 WEIGHTS_FORMAT = "envelope-bench-segmenter-1"
-DEFAULT_WEIGHTS = Path(__file__).resolve().parent / "weights" / "default.pt"
-"""The committed weights (trained on the ``segtrain`` preset; record in ``default.json``)."""
+WEIGHTS_DIR = Path(__file__).resolve().parent / "weights"
+BUILT_IN_WEIGHTS: dict[str, Path] = {
+    "photos": WEIGHTS_DIR / "photos.pt",
+    "renders": WEIGHTS_DIR / "renders.pt",
+}
+"""The committed weights by name (each with its training record beside it as ``.json``):
+``renders`` trained on the ``segtrain`` renders alone, with its window calibration;
+``photos`` on labelled real facade photos (LabelMeFacade, CMP; non-commercial research use,
+see the record) and the renders. docs/segment.md says what each gives on real photos."""
+DEFAULT_WEIGHTS_NAME = "renders"
+DEFAULT_WEIGHTS = BUILT_IN_WEIGHTS[DEFAULT_WEIGHTS_NAME]
+"""What ``--masks predicted`` and every segmenter command use unless told otherwise: the
+render-trained weights; the photo-trained ones gave a larger WWR error on the CMP validation
+facades (docs/decisions.md, 2026-11-29)."""
+RENDER_WEIGHTS = BUILT_IN_WEIGHTS["renders"]
 _TRAIN_HINT = "train weights with `python -m segment.train` (docs/segment.md)"
 
 

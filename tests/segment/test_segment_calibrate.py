@@ -20,7 +20,7 @@ from segment.calibrate import (
 from segment.network import UNet, UNetConfig
 from segment.segmenter import calibrated_offsets, network_segmenter, predict_labels
 from segment.training_data import load_training_scenes
-from segment.weights import DEFAULT_WEIGHTS, load_network, save_weights
+from segment.weights import RENDER_WEIGHTS, load_network, save_weights
 
 WINDOW = SemanticClass.WINDOW
 BIN = MARGIN_EDGES[1] - MARGIN_EDGES[0]
@@ -129,11 +129,11 @@ def test_weights_without_validation_buildings_or_with_none_found_are_refused(
 
 
 def test_the_committed_weights_are_calibrated_on_their_validation_buildings():
-    _, record = load_network(DEFAULT_WEIGHTS)
+    _, record = load_network(RENDER_WEIGHTS)
     cal = record["calibration"]
     names = sorted(f"{v['folder']}/{v['scene']}" for v in record["validated_on"])
     assert cal["scenes"] == names
     assert abs(cal["area_ratio_after"] - 1.0) < 0.01
     assert cal["iou_after"] >= cal["iou_before"] - 0.01
-    offsets = calibrated_offsets(record, DEFAULT_WEIGHTS)
+    offsets = calibrated_offsets(record, RENDER_WEIGHTS)
     assert offsets is not None and offsets[WINDOW] == cal["window_offset"]

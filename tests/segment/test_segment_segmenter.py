@@ -51,8 +51,16 @@ def test_a_segmenter_is_only_given_uint8_rgb(rgb):
         segment_rgb(_segmenter(lambda x: np.zeros(x.shape[:2], np.uint8)), rgb)
 
 
+def test_the_committed_weights_resolve_by_name():
+    assert resolve_segmenter("photos", threads=1).name == "photos"
+    assert resolve_segmenter("renders", threads=1).name == "renders"
+    default = resolve_segmenter(None, threads=1)
+    assert default.name == "renders" and default.identity == resolve_segmenter(
+        "default", threads=1).identity
+
+
 def test_unknown_names_list_what_is_there(tmp_path):
-    with pytest.raises(ValueError, match="unknown segmenter 'nope'.*'default'"):
+    with pytest.raises(ValueError, match=r"unknown segmenter 'nope'.*\(default, photos, renders"):
         resolve_segmenter("nope")
     with pytest.raises(ValueError, match="not found"):
         resolve_segmenter(str(tmp_path / "missing.pt"))

@@ -12,10 +12,18 @@ import torch
 from dataset.presets import preset_recipes
 from envelope.classes import CLASS_NAMES
 from segment.network import UNet, UNetConfig
+from segment.real_sets.splits import committed_splits
 from segment.segmenter import predict_labels
 from segment.train import TrainConfig
 from segment.training_data import EVALUATED_PRESETS
-from segment.weights import DEFAULT_WEIGHTS, WEIGHTS_FORMAT, load_network, save_weights
+from segment.weights import (
+    BUILT_IN_WEIGHTS,
+    DEFAULT_WEIGHTS,
+    RENDER_WEIGHTS,
+    WEIGHTS_FORMAT,
+    load_network,
+    save_weights,
+)
 
 SMALL = UNetConfig(base_channels=4, levels=3)
 MAX_COMMITTED_BYTES = 20 * 2**20
@@ -49,16 +57,24 @@ def test_weights_round_trip_with_their_record(tmp_path):
     assert agree.mean() > 0.99
 
 
-def test_the_committed_weights_load_without_network_and_say_how_they_were_made(monkeypatch):
+def _committed(path):
+    """The record of committed weights, after the checks every committed file passes: small,
+    loaded offline with ``weights_only=True``, the record beside it the same."""
+    assert path.stat().st_size <= MAX_COMMITTED_BYTES
+    model, record = load_network(path)
+    assert model.config.num_classes == len(CLASS_NAMES)
+    assert record == json.loads(path.with_suffix(".json").read_text())
+    return record
+
+
+def test_the_committed_render_weights_load_without_network_and_say_how_they_were_made(
+        monkeypatch):
     def no_network(*args, **kwargs):
         raise AssertionError("loading the weights tried to open a network connection")
 
     monkeypatch.setattr(socket, "socket", no_network)
     monkeypatch.setattr(socket, "create_connection", no_network)
-    assert DEFAULT_WEIGHTS.stat().st_size <= MAX_COMMITTED_BYTES
-    model, record = load_network(DEFAULT_WEIGHTS)
-    assert model.config.num_classes == len(CLASS_NAMES)
-    assert record == json.loads(DEFAULT_WEIGHTS.with_suffix(".json").read_text())
+    record = _committed(RENDER_WEIGHTS)
     # trained on segtrain buildings only: no building of an evaluated preset, by seed or name
     evaluated = {(r.family, r.seed) for p in EVALUATED_PRESETS for r in preset_recipes(p)}
     used = record["trained_on"] + record["validated_on"]
@@ -71,6 +87,31 @@ def test_the_committed_weights_load_without_network_and_say_how_they_were_made(m
     assert not record["cut_short"]
     assert set(record["provenance"]["code"]) == {"segment", "dataset"}
     assert record["provenance"]["environment"]["torch"]
+
+
+def test_the_committed_photo_weights_name_every_set_and_licence(monkeypatch):
+    def no_network(*args, **kwargs):
+        raise AssertionError("loading the weights tried to open a network connection")
+
+    monkeypatch.setattr(socket, "socket", no_network)
+    monkeypatch.setattr(socket, "create_connection", no_network)
+    assert DEFAULT_WEIGHTS == RENDER_WEIGHTS  # the default (docs/decisions.md, 2026-11-29)
+    record = _committed(BUILT_IN_WEIGHTS["photos"])
+    sets = record["training_sets"]
+    assert set(sets) == {"renders", "labelmefacade", "cmp"}
+    assert sets["labelmefacade"]["licence"].startswith("non-commercial research use only")
+    # real photos of the train split only; the validation photos of the val split; no test photo
+    splits = {s: committed_splits(s) for s in ("labelmefacade", "cmp")}
+    real_train = [s for s in record["trained_on"] if "set" in s]
+    real_val = [s for s in record["validated_on"] if "set" in s]
+    assert {s["set"] for s in real_train} == {s["set"] for s in real_val} == set(splits)
+    for s in real_train + real_val:
+        assert s["split"] == ("train" if s in real_train else "val")
+        assert all(splits[s["set"]][n] == s["split"] for n in s.get("names", []))
+    renders = [s for s in record["trained_on"] + record["validated_on"] if "set" not in s]
+    assert renders and {s["preset"] for s in renders} == {"segtrain"}
+    assert record["cut_short"] == (record["steps_run"] < record["config"]["steps"])
+    assert set(record["provenance"]["code"]) == {"segment", "envelope", "dataset"}
 
 
 def test_a_missing_file_says_how_to_make_one(tmp_path):
