@@ -1,5 +1,6 @@
 """Structure from motion with COLMAP (pycolmap, on the CPU): upright copies of the photos
-in, the largest model out, or a clear error when the photos do not overlap.
+in, the largest model out, or a clear error when the photos do not overlap. COLMAP's own
+log shows its warnings and errors only.
 
 Each camera group (:func:`dataset.importers.photos.photo_folder.camera_groups`) shares one
 ``SIMPLE_RADIAL`` camera (focal length, principal point, one radial term), started from the
@@ -42,6 +43,25 @@ def reconstruct(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
         No model, or one holding fewer than :data:`MIN_REGISTERED_FRACTION` of the photos
         (the message says how many were placed and what to photograph).
     """
+    previous = pycolmap.logging.minloglevel
+    pycolmap.logging.minloglevel = int(pycolmap.logging.WARNING)
+    try:
+        models = _models(photos, upright_dir, work_dir, config)
+    finally:
+        pycolmap.logging.minloglevel = previous
+    best = max(models.values(), key=lambda r: r.num_reg_images(), default=None)
+    placed = 0 if best is None else best.num_reg_images()
+    if placed < max(2, MIN_REGISTERED_FRACTION * len(photos)):
+        raise ValueError(
+            f"structure from motion placed {placed} of {len(photos)} photos in one model "
+            f"({len(models)} models): the photos do not overlap enough. Photograph the building "
+            "walking round it, each photo overlapping the last by well over half, each part in "
+            "three photos or more, avoiding plain walls and glass filling the frame")
+    return best
+
+
+def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
+            config: SfmConfig) -> dict[int, pycolmap.Reconstruction]:
     database = work_dir / "database.db"
     extraction = pycolmap.FeatureExtractionOptions()
     extraction.num_threads = config.threads
@@ -58,13 +78,4 @@ def reconstruct(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
     mapping = pycolmap.IncrementalPipelineOptions()
     mapping.num_threads = config.threads
     mapping.random_seed = config.seed
-    models = pycolmap.incremental_mapping(database, upright_dir, work_dir / "sparse", mapping)
-    best = max(models.values(), key=lambda r: r.num_reg_images(), default=None)
-    placed = 0 if best is None else best.num_reg_images()
-    if placed < max(2, MIN_REGISTERED_FRACTION * len(photos)):
-        raise ValueError(
-            f"structure from motion placed {placed} of {len(photos)} photos in one model "
-            f"({len(models)} models): the photos do not overlap enough. Photograph the building "
-            "walking round it, each photo overlapping the last by well over half, each part in "
-            "three photos or more, avoiding plain walls and glass filling the frame")
-    return best
+    return pycolmap.incremental_mapping(database, upright_dir, work_dir / "sparse", mapping)
