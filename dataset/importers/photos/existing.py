@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pycolmap
 
 from dataset.importers.photos.posed import (
     PosedPhoto,
@@ -55,6 +54,8 @@ def read_colmap_project(path: Path) -> PosedPhotos:
     ValueError
         No model there, an unreadable model or a missing image.
     """
+    import pycolmap  # imported here: half a second, for this source alone
+
     folder = colmap_model_folder(path)
     if folder is None:
         raise ValueError(f"{path} holds no COLMAP model (sparse/0/ with cameras, images and "
@@ -93,6 +94,8 @@ def read_nerfstudio(path: Path) -> PosedPhotos:
 
 
 def _frame(root: Path, meta: dict[str, Any], frame: dict[str, Any]) -> PosedPhoto:
+    import pycolmap
+
     def get(key: str, default: Any = None) -> Any:
         return frame.get(key, meta.get(key, default))
 

@@ -7,13 +7,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pycolmap
 
 from dataset.importers.photos.conventions import world_from_camera_gl
 from envelope.camera import Intrinsics
 from envelope.photo_io import read_photo_rgb
+
+if TYPE_CHECKING:
+    import pycolmap
 
 PINHOLE_MODELS = ("SIMPLE_PINHOLE", "PINHOLE")
 
@@ -82,6 +85,8 @@ def undistorted_rgb(photo: PosedPhoto) -> tuple[np.ndarray, Intrinsics]:
     ValueError
         An unreadable photo, or one of another size than its camera.
     """
+    import pycolmap  # imported here: half a second, for this source alone
+
     rgb = read_photo_rgb(photo.path, upright=photo.upright)
     cam = photo.camera
     if rgb.shape[:2] != (cam.height, cam.width):

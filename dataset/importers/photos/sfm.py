@@ -14,10 +14,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-
-import pycolmap
+from typing import TYPE_CHECKING
 
 from dataset.importers.photos.photo_folder import Photo, camera_groups
+
+if TYPE_CHECKING:
+    import pycolmap
 
 MIN_REGISTERED_FRACTION = 0.5
 """The largest model must hold at least this share of the photos; fewer means the photos
@@ -43,6 +45,8 @@ def reconstruct(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
         No model, or one holding fewer than :data:`MIN_REGISTERED_FRACTION` of the photos
         (the message says how many were placed and what to photograph).
     """
+    import pycolmap  # imported here: half a second, for this source alone
+
     previous = pycolmap.logging.minloglevel
     pycolmap.logging.minloglevel = int(pycolmap.logging.WARNING)
     try:
@@ -62,6 +66,8 @@ def reconstruct(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
 
 def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
             config: SfmConfig) -> dict[int, pycolmap.Reconstruction]:
+    import pycolmap
+
     database = work_dir / "database.db"
     extraction = pycolmap.FeatureExtractionOptions()
     extraction.num_threads = config.threads
