@@ -13,6 +13,7 @@ written into a temporary folder renamed when complete, so a failure leaves nothi
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -123,7 +124,8 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                                 round(float(model.compute_mean_reprojection_error()), 4)})
 
 
-def _write(read, path: Path, options: PhotosOptions, out_dir: Path) -> Scene:
+def _write(read: Callable[[Path], PosedPhotos], path: Path, options: PhotosOptions,
+           out_dir: Path) -> Scene:
     """Pose the photos of ``path`` with ``read``, take them to metres and z up, and write
     the scene into ``out_dir``."""
     posed = read(path)
