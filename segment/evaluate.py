@@ -20,10 +20,10 @@ from tqdm import tqdm
 from envelope.atomic import write_text_atomic
 from envelope.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
 from envelope.cli_errors import add_debug_flag, exit_cli, run_cli
+from envelope.photo_io import read_photo_rgb
 from envelope.scene_record import Scene
 from envelope.scenes.scene import read_scene
 from envelope.scenes.scene_validation import read_frame_labels
-from segment.photo_io import read_photo_rgb
 from segment.scene_masks import scene_folders
 from segment.segmenter import Segmenter, resolve_segmenter, segment_rgb
 

@@ -8,7 +8,7 @@ reuses copies made by the same segmenter from the same scenes.
 
 ``--photos``: writes ``<out>/<stem>.png`` (class ids, one byte per pixel, of the upright
 photo) for every image file given or in the folder given. Each photo is read by
-:func:`segment.photo_io.read_photo_rgb` (EXIF orientation applied; grey, 16-bit, CMYK,
+:func:`envelope.photo_io.read_photo_rgb` (EXIF orientation applied; grey, 16-bit, CMYK,
 palette and alpha images converted); one that cannot be read (truncated, corrupt) is
 named with the reason on stderr and skipped, the others are segmented, and the exit
 status is 1.

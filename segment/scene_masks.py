@@ -28,6 +28,7 @@ from tqdm import tqdm
 from dataset.degrade.scene_copy import link_tree
 from envelope.atomic import atomic_directory
 from envelope.classes import CLASS_NAMES
+from envelope.photo_io import read_photo_rgb
 from envelope.provenance import (
     Provenance,
     file_fingerprint,
@@ -37,7 +38,6 @@ from envelope.provenance import (
 from envelope.scene_record import Frame
 from envelope.scenes.images import write_labels
 from envelope.scenes.scene import read_scene, write_transforms
-from segment.photo_io import read_photo_rgb
 from segment.segmenter import Segmenter, segment_rgb
 
 RECORD_KEY = "predicted_masks"
