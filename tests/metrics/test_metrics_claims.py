@@ -128,7 +128,7 @@ def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
 
 
 def test_claims_tables_leave_out_tables_without_rows():
-    from metrics.compare import claims_tables
+    from metrics.comparison import claims_tables
 
     rows = [BuildingErrors(s, "l_shaped", "2D-S", "ideal", wwr_ape=e) for s, e in (("a", 1.0),
                                                                                   ("b", 2.0))]
