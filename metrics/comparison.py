@@ -34,6 +34,12 @@ from metrics.report.report import (
     table3_footprint_iou,
     timing_table,
 )
+from metrics.report.report_data import (
+    FOOTPRINTS_FOLDER,
+    PIPELINE_FOLDER,
+    PROVENANCE_FILE,
+    report_data,
+)
 from metrics.report.report_facades import FACADE_SCORES_NAME, facade_scores_table
 from metrics.report.report_orientation import orientation_table
 from metrics.report.report_paper import (
@@ -63,9 +69,6 @@ from metrics.score.orientation_errors import (
     summarise_orientations,
 )
 
-PROVENANCE_FILE = "provenance.json"
-PIPELINE_FOLDER = "2dss_pipeline"
-FOOTPRINTS_FOLDER = "footprints"
 PLOTS_FOLDER = "plots"
 CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME,
                       FACADE_SCORES_NAME)
@@ -73,7 +76,7 @@ CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, P
 
 @dataclass(frozen=True)
 class Comparison:
-    """What one comparison produced: per-building and per-facade rows and the two tables."""
+    """What one comparison produced: per-building and per-facade rows and the tables."""
 
     rows: tuple[BuildingErrors, ...]
     facade_rows: tuple[FacadeErrors, ...]
@@ -81,6 +84,13 @@ class Comparison:
     table3: Table
     outcomes: tuple[Outcome, ...]
     more_tables: tuple[Table, ...] = ()  # visible truth, seed spread, the paper's, facade scores
+    orientation: Table | None = None  # WWR error per facade orientation
+
+    @property
+    def tables(self) -> tuple[Table, ...]:
+        """Every table it writes as CSV, Markdown and LaTeX, in that order."""
+        return (self.table2, self.table3, *self.more_tables,
+                *((self.orientation,) if self.orientation is not None else ()))
 
 
 def compare(
@@ -116,6 +126,8 @@ def compare(
     footprint_methods = {s.name for s in specs if s.has_footprint}
     footer = f"made by {methods_provenance_text(specs)}; details in {PROVENANCE_FILE}"
     table2, table3 = table2_errors(groups), table3_footprint_iou(groups, footprint_methods)
+    orientation = orientation_table(summarise_orientations(orientation_errors_of(
+        (o.result, truths.get(o.scene)) for o in outcomes if o.result is not None)))
     comparison = Comparison(
         rows=tuple(rows),
         facade_rows=tuple(facade_rows),
@@ -124,21 +136,10 @@ def compare(
         outcomes=tuple(outcomes),
         more_tables=(*claims_tables(groups, paper_names_of(specs)),
                      *((facade_scores_table(facade_rows, groups),) if facade_rows else ())),
+        orientation=replace(orientation, notes=(*orientation.notes, footer)),
     )
     provenance = _provenance(data, results_dir, specs, outcomes, command)
-    comment = f"produced by `{command}`; {footer}"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    orientation = orientation_table(summarise_orientations(orientation_errors_of(
-        (o.result, truths.get(o.scene)) for o in outcomes if o.result is not None)))
-    for table in (comparison.table2, comparison.table3, *comparison.more_tables,
-                  replace(orientation, notes=(*orientation.notes, footer))):
-        write_table(table, out_dir, comment)
-    for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
-        for suffix in (".csv", ".md", ".tex"):  # a table with no rows this time: none stale
-            (out_dir / f"{name}{suffix}").unlink(missing_ok=True)
-    for table in (per_building_table(rows), per_facade_table(facade_rows),
-                  timing_table(run_timings(outcomes))):
-        write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
+    _write_tables(comparison, out_dir, f"produced by `{command}`; {footer}")
     write_plots(groups, rows, out_dir / PLOTS_FOLDER)
     write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
     for spec in specs:
@@ -147,8 +148,22 @@ def compare(
     if allow_run and with_images:
         keep_pipeline_images(scene_dirs, with_images[0], out_dir / PIPELINE_FOLDER)
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
-    write_html_report(out_dir)
+    write_html_report(report_data(comparison.tables, rows, provenance, out_dir))
     return comparison
+
+
+def _write_tables(comparison: Comparison, out_dir: Path, comment: str) -> None:
+    """The tables (CSV, Markdown, LaTeX; none left of a claims table without rows this
+    time) and the per-building, per-facade and timing CSVs, each headed by ``comment``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for table in comparison.tables:
+        write_table(table, out_dir, comment)
+    for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
+        for suffix in (".csv", ".md", ".tex"):
+            (out_dir / f"{name}{suffix}").unlink(missing_ok=True)
+    for table in (per_building_table(comparison.rows), per_facade_table(comparison.facade_rows),
+                  timing_table(run_timings(comparison.outcomes))):
+        write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
 
 
 def paper_names_of(specs: Sequence[MethodSpec]) -> dict[str, str]:
