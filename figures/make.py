@@ -24,7 +24,7 @@ from figures.meshes import plot_reconstructed_meshes, reconstructed_meshes
 from figures.pipeline import plot_2dss_pipeline
 from figures.renders import plot_example_renders
 from figures.style import MissingInput
-from metrics.compare import FOOTPRINTS_FOLDER, PIPELINE_FOLDER, PROVENANCE_FILE
+from metrics.comparison import FOOTPRINTS_FOLDER, PIPELINE_FOLDER, PROVENANCE_FILE
 from metrics.report.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report.report import PER_BUILDING_NAME, read_building_errors_csv
 from metrics.report.tables import write_table

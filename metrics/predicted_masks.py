@@ -22,10 +22,10 @@ import numpy as np
 
 from envelope.classes import SemanticClass
 from envelope.scenes.scene import read_scene
+from metrics.comparison import compare
 from metrics.report.tables import Table, write_table
 from metrics.run.predicted_masks import (
     TABLE_NAME,
-    CompareFn,
     PredictedRun,
     predicted_run,
     splits_read,
@@ -40,12 +40,12 @@ from segment.segmenter import Segmenter
 
 def compare_on_predicted_masks(
     segmenter: Segmenter, data: Path, results: Path, out: Path,
-    specs_for: Callable[[Path], list[MethodSpec]], compare: CompareFn, *, command: str,
-    **options,
+    specs_for: Callable[[Path], list[MethodSpec]], *, command: str, **options,
 ) -> tuple[Table, PredictedRun]:
     """Compare on exact masks and on ``segmenter``'s; write the table :data:`TABLE_NAME`
     into the predicted run's ``out`` and return it with the run's folders (``options``
-    go to ``compare``; ``specs_for(results folder)`` makes the methods' specs)."""
+    go to :func:`metrics.comparison.compare`; ``specs_for(results folder)`` makes the
+    methods' specs)."""
     specs = specs_for(results)
     exact = compare(data, specs, results, out, command=command, **options)
     run = predicted_run(data, results, out, segmenter, splits_read(specs))

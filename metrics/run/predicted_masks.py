@@ -33,9 +33,6 @@ from segment.segmenter import DEFAULT_NAME, Segmenter, resolve_segmenter
 CONFIG_KEY = "masks"
 PREDICTED = "predicted"
 TABLE_NAME = "exact_vs_predicted"
-CompareFn = Callable[..., Any]
-"""``metrics.compare.compare``: ``(data, specs, results, out, **options) -> Comparison``
-(passed in: ``metrics.compare`` imports this module, not the other way round)."""
 
 
 @dataclass(frozen=True)
