@@ -45,7 +45,7 @@ from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
 from envelope.atomic import write_text_atomic  # noqa: E402
 from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
 from envelope.results import MethodResult  # noqa: E402
-from metrics.compare import compare  # noqa: E402
+from metrics.comparison import compare  # noqa: E402
 from metrics.run.executors import make_executor  # noqa: E402
 from metrics.run.methods import method_specs  # noqa: E402
 from metrics.run.runner import Job, MethodSpec, find_scenes, run_job, run_missing  # noqa: E402
