@@ -25,6 +25,7 @@ from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, r
 from envelope.footprint import geojson_to_polygon
 from envelope.orientation import true_north_xy_from_world
 from envelope.results import MethodResult, code_version, read_result
+from envelope.scenes.scene import find_scene_folders
 from envelope.truth import BuildingTruth, read_building
 from metrics.export.cityjson import cityjson_building
 from metrics.export.formats import (
@@ -47,7 +48,6 @@ from metrics.export.table import (
     result_rows,
     truth_rows,
 )
-from metrics.run.runner import find_scenes
 from metrics.score.aggregate import method_rank, protocol_rank
 from metrics.score.facade_scoring import estimates_by_truth_facade
 
@@ -85,7 +85,7 @@ def read_inputs(results_dir: Path, data_dir: Path | None) -> ExportInputs:
         raise ValueError(f"{results_dir} holds no readable result file (<scene>__<method>__"
                          "<protocol>.json); run `python -m metrics.compare` first")
     truths = {}
-    for scene_dir in find_scenes(data_dir) if data_dir is not None else ():
+    for scene_dir in find_scene_folders(data_dir) if data_dir is not None else ():
         if (scene_dir / "building.json").is_file():
             try:
                 truth = read_building(scene_dir / "building.json")

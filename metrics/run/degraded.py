@@ -18,7 +18,8 @@ from tqdm import tqdm
 
 from dataset.degrade.scene_copy import degrade_scene
 from dataset.degrade.spec import DegradeSpec, specs_key
-from metrics.run.runner import MethodSpec, find_scenes
+from envelope.scenes.scene import find_scene_folders
+from metrics.run.runner import MethodSpec
 
 CONFIG_KEY = "degradation"
 
@@ -37,7 +38,7 @@ def degraded_run(data: Path, results: Path, out: Path,
     """Degrade every scene of ``data`` (reusing finished copies) and name the folders."""
     key = specs_key(specs)
     cache = data.with_name(f"{data.name}-degraded") / key
-    scenes = [d for d in find_scenes(data) if (d / "transforms.json").is_file()]
+    scenes = find_scene_folders(data, with_images=True)
     for scene_dir in tqdm(scenes, desc=f"degrade {key}", unit="scene", leave=False):
         degrade_scene(scene_dir, cache, specs)
     return DegradedRun(cache, results / "degraded" / key, out.with_name(f"{out.name}-{key}"))

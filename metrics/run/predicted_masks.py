@@ -26,7 +26,8 @@ from typing import Any
 from tqdm import tqdm
 
 from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
-from metrics.run.runner import MethodSpec, find_scenes
+from envelope.scenes.scene import find_scene_folders
+from metrics.run.runner import MethodSpec
 from segment.scene_masks import predicted_scene
 from segment.segmenter import DEFAULT_NAME, Segmenter, resolve_segmenter
 
@@ -115,7 +116,7 @@ def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter,
     """
     key = masks_key(segmenter)
     cache = data.with_name(f"{data.name}-masks") / key
-    scenes = [d for d in find_scenes(data) if (d / "transforms.json").is_file()]
+    scenes = find_scene_folders(data, with_images=True)
     for scene_dir in tqdm(scenes, desc=f"masks {key}", unit="scene", leave=False):
         predicted_scene(scene_dir, cache, segmenter, splits=splits)
     return PredictedRun(cache, results / "masks" / key, out.with_name(f"{out.name}-masks-{key}"),

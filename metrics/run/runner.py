@@ -36,6 +36,10 @@ from envelope.provenance import (
     provenance_changes,
 )
 from envelope.results import MethodResult, read_result, result_filename, write_result
+from envelope.scenes.scene import find_scene_folders as find_scenes  # noqa: F401
+
+# ``find_scenes`` is :func:`envelope.scenes.scene.find_scene_folders`, the one scene finder,
+# under the name metrics.compare and bench/ import it by.
 
 RunFn = Callable[[Path, str], MethodResult]
 """(scene folder, protocol) -> the method's result for that scene; may raise."""
@@ -115,29 +119,6 @@ def execute_local(jobs: Sequence[Job], run_one: RunOne) -> Iterator[tuple[int, O
     """Run the jobs one after the other in this process."""
     for i, job in enumerate(jobs):
         yield i, run_one(job)
-
-
-def find_scenes(data: str | Path) -> list[Path]:
-    """Scene folders in ``data``: ``data`` itself if it is one, else its sub-folders that are.
-
-    A scene folder holds ``transforms.json`` (images to run methods on) or
-    ``building.json`` (ground truth); hidden folders (``.<name>.partial``: a copy a killed
-    run left unfinished, see :func:`envelope.atomic.atomic_directory`) are not scenes.
-    Raises ``ValueError`` when there is none.
-    """
-    data = Path(data)
-    if not data.is_dir():
-        raise ValueError(f"data folder {data} does not exist")
-    if _is_scene(data):
-        return [data]
-    scenes = sorted(p for p in data.iterdir()
-                    if p.is_dir() and not p.name.startswith(".") and _is_scene(p))
-    if not scenes:
-        raise ValueError(
-            f"{data} holds no scene folder (one with transforms.json or building.json); "
-            "make a benchmark with `python -m dataset.generate --preset tiny --out DIR`"
-        )
-    return scenes
 
 
 def expected_provenance(scene_dir: Path, spec: MethodSpec) -> Provenance:
@@ -260,6 +241,3 @@ def _where(exc: BaseException) -> str:
         return ""
     return f" (at {Path(frames[-1].filename).resolve().relative_to(root)}:{frames[-1].lineno})"
 
-
-def _is_scene(folder: Path) -> bool:
-    return (folder / "transforms.json").is_file() or (folder / "building.json").is_file()

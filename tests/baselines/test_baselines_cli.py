@@ -9,28 +9,18 @@ import pytest
 
 import baselines.cli
 from baselines import wwr2ds, wwr2dss
-from baselines.cli import scene_folders
 from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
 from envelope.method import available_methods
 from envelope.results import MethodResult, read_result
+from envelope.scenes.scene import find_scene_folders
 from envelope.truth import read_building
 from metrics.run.compare_args import compare_request, parse_compare_args
 
 
-def test_scene_folders_and_default_results_folder(tmp_path):
-    for name in ("b", "a"):
-        (tmp_path / "bench" / name).mkdir(parents=True)
-        (tmp_path / "bench" / name / "transforms.json").write_text("{}")
-    (tmp_path / "bench" / "notes").mkdir()
+def test_default_results_folder(tmp_path):
     bench = tmp_path / "bench"
-    assert [p.name for p in scene_folders(bench)] == ["a", "b"]
-    assert scene_folders(bench / "a") == [bench / "a"]
     assert default_results_folder(bench) == tmp_path / "bench-results"
     assert default_results_folder(bench / "a") == bench / "a-results"
-    with pytest.raises(ValueError, match="neither a scene folder"):
-        scene_folders(bench / "notes")
-    with pytest.raises(ValueError, match="does not exist"):
-        scene_folders(tmp_path / "nowhere")
 
 
 @pytest.mark.slow
@@ -40,7 +30,7 @@ def test_both_clis_on_the_tiny_benchmark(tiny_benchmark, tmp_path, views):
     assert wwr2ds.main(["--views", views, "--data", str(tiny_benchmark), "--out", str(out)]) == 0
     assert wwr2dss.main(["--views", views, "--data", str(tiny_benchmark), "--out", str(out),
                          "--debug-images", str(tmp_path / "dbg")]) == 0
-    scenes = scene_folders(tiny_benchmark)
+    scenes = find_scene_folders(tiny_benchmark)
     for scene in scenes:
         truth = read_building(scene / "building.json")
         for method in ("2D-S", "2D-SS"):
@@ -85,7 +75,7 @@ def test_without_data_the_default_benchmark_is_made_and_measured(tmp_path, monke
     out, err = capsys.readouterr()
     folder = default().folder
     assert f"no --data: the built-in 'tiny' benchmark in {folder} (generating it now)" in err
-    scenes = scene_folders(folder)
+    scenes = find_scene_folders(folder)
     assert len(scenes) == 3
     for scene in scenes:
         result = read_result(default_results_folder(folder) / f"{scene.name}__2D-SS__multi.json")

@@ -3,7 +3,6 @@
 from dataclasses import replace
 from pathlib import Path
 
-import pytest
 from metrics_helpers import make_result, make_truth
 
 from envelope.results import read_result
@@ -80,11 +79,3 @@ def test_no_run_reports_missing_results(tmp_path):
     out = run_missing(scenes, [spec], tmp_path / "results", allow_run=False, log=lambda _: None)
     assert out[0].status == "failed" and "no result file a__fake__ideal.json" in out[0].reason
 
-
-def test_find_scenes(tmp_path):
-    assert find_scenes(_scenes(tmp_path / "data", ("a",))[0]) == [tmp_path / "data" / "a"]
-    (tmp_path / "empty").mkdir()
-    with pytest.raises(ValueError, match="holds no scene folder"):
-        find_scenes(tmp_path / "empty")
-    with pytest.raises(ValueError, match="does not exist"):
-        find_scenes(tmp_path / "nope")
