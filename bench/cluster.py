@@ -48,7 +48,14 @@ from envelope.results import MethodResult  # noqa: E402
 from metrics.compare import compare  # noqa: E402
 from metrics.run.executors import make_executor  # noqa: E402
 from metrics.run.methods import method_specs  # noqa: E402
-from metrics.run.runner import Job, MethodSpec, find_scenes, run_job, run_missing  # noqa: E402
+from metrics.run.runner import (  # noqa: E402
+    Job,
+    MethodSpec,
+    find_scenes,
+    folder_spec,
+    run_job,
+    run_missing,
+)
 from neural3d.method import Neural3dBudget  # noqa: E402
 
 NODES = (1, 2, 4, 8, 16, 32, 64)
@@ -58,7 +65,7 @@ def _noop_spec() -> MethodSpec:
     def run(scene_dir: Path, protocol: str) -> MethodResult:
         return MethodResult(scene_dir.name, "noop", protocol, None, None, None)
 
-    return MethodSpec("noop", ("ideal",), {}, run)
+    return folder_spec("noop", ("ideal",), {}, run)
 
 
 def time_comparisons(data: Path, specs_for, tmp: Path, ray: RayConfig) -> dict:

@@ -46,13 +46,6 @@ def degraded_run(data: Path, results: Path, out: Path,
 
 def with_degradation(specs: Sequence[MethodSpec],
                      degradation: tuple[DegradeSpec, ...]) -> list[MethodSpec]:
-    """The same methods, their requested and written configs carrying the specs."""
+    """The same methods, the configs their results record carrying the specs."""
     record = [s.to_json() for s in degradation]
-
-    def wrap(run):
-        def degraded(scene_dir: Path, protocol: str):
-            result = run(scene_dir, protocol)
-            return replace(result, config={**result.config, CONFIG_KEY: record})
-        return degraded
-
-    return [replace(s, config={**s.config, CONFIG_KEY: record}, run=wrap(s.run)) for s in specs]
+    return [replace(s, conditions={**s.conditions, CONFIG_KEY: record}) for s in specs]

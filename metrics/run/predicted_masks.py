@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -124,14 +123,6 @@ def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter,
 
 
 def with_predicted_masks(specs: Sequence[MethodSpec], segmenter: Segmenter) -> list[MethodSpec]:
-    """The same methods, their requested and written configs naming the segmenter (each
-    run stays picklable, so a method still runs in a process of its own or on Ray)."""
+    """The same methods, the configs their results record naming the segmenter."""
     record = {"segmenter": segmenter.name, **segmenter.identity}
-    return [replace(s, config={**s.config, CONFIG_KEY: record},
-                    run=partial(_run_on_masks, s.run, record)) for s in specs]
-
-
-def _run_on_masks(run: Callable, record: dict[str, Any], scene_dir: Path, protocol: str, **kwargs):
-    """``run``'s result with the segmenter ``record`` in its config."""
-    result = run(scene_dir, protocol, **kwargs)
-    return replace(result, config={**result.config, CONFIG_KEY: record})
+    return [replace(s, conditions={**s.conditions, CONFIG_KEY: record}) for s in specs]

@@ -65,6 +65,25 @@ def test_results_go_where_compare_reads_them_and_are_printed(clean_scene, tmp_pa
     assert f"-> {path}" in out
 
 
+@pytest.mark.parametrize("cli, name", [(wwr2ds, "2D-S"), (wwr2dss, "2D-SS")])
+def test_the_command_line_writes_the_file_compare_looks_for(clean_scene, tmp_path, cli, name):
+    """The result file is named by the Method's name alone: the one the command line writes
+    is the one the comparison looks up (found; stale, as it carries no provenance record)."""
+    from metrics.run.methods import method_specs
+    from metrics.run.runner import run_missing
+
+    data = tmp_path / "bench"
+    shutil.copytree(clean_scene, data / clean_scene.name)
+    assert cli.main(["--views", "ideal", "--data", str(data)]) == 0
+    written = sorted(default_results_folder(data).iterdir())
+    specs = method_specs((name,), ("ideal",), default_results_folder(data))
+    assert [s.method.name for s in specs] == [name]
+    found = run_missing(find_scene_folders(data), specs, default_results_folder(data),
+                        allow_run=False, log=lambda _: None)
+    assert [o.path for o in found] == written and [o.status for o in found] == ["stale"]
+    assert read_result(written[0]).method == name
+
+
 @pytest.mark.slow
 def test_without_data_the_default_benchmark_is_made_and_measured(tmp_path, monkeypatch, capsys):
     # The default benchmark, small: 64 px and 8 orbit views instead of 128 px and 40.

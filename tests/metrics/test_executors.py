@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
+from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig
 from envelope.results import read_result
 from metrics.compare import main
 from metrics.run.executors import make_executor
@@ -64,6 +64,10 @@ def _ctrl_c_raises():
 
 def _attempts(path: Path) -> list[str]:
     return path.read_text().splitlines() if path.is_file() else []
+
+
+def _a_gpu(config):
+    return 1.0, 1.0
 
 
 def _faulty_2ds(log: Path, die_on: set[str], *, always: bool = False,
@@ -111,8 +115,8 @@ def test_2d_methods_give_the_same_tables_with_ray_and_local(local_ray, tiny_benc
 
 def test_a_task_the_cluster_cannot_place_is_refused_and_names_are_checked(
         local_ray, tiny_benchmark, tmp_path):
-    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0],
-                   resources=TaskResources(cpus=1.0, gpus=1.0))
+    spec = method_specs(("2D-S",), ("ideal",), tmp_path)[0]
+    spec = replace(spec, method=replace(spec.method, reserve=_a_gpu))
     with pytest.raises(ValueError, match="needs 1 GPU"):
         run_missing(find_scenes(tiny_benchmark), [spec], tmp_path / "results", log=_quiet,
                     execute=make_executor("ray", CONFIG))

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import pytest
 
-from envelope.executors.ray_tasks import TaskResources
 from envelope.progress import progress_bar
 from envelope.results import read_result
 from metrics.run.executors import make_executor
@@ -35,6 +34,17 @@ def _dies_on_first_scene(scene_dir, protocol):
     if scene_dir.name == "tiny_l_shaped":
         os._exit(3)
     return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
+
+
+def _reserve(cpus, config):
+    return cpus, 0.0
+
+
+def _heavy_2ds(tmp_path, cpus=1.0, **spec_fields):
+    """2D-S on the ideal views, declared heavy, reserving ``cpus`` cores a run."""
+    spec = method_specs(("2D-S",), ("ideal",), tmp_path)[0]
+    method = replace(spec.method, heavy=True, reserve=partial(_reserve, cpus))
+    return replace(spec, method=method, **spec_fields)
 
 
 def _2ds_noting_its_process(folder, scene_dir, protocol):
@@ -62,7 +72,7 @@ def _without_times(outcomes):
 def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
     light = method_specs(("2D-SS",), ("ideal",), tmp_path)[0]
-    heavy = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True)
+    heavy = _heavy_2ds(tmp_path)
     local = run_missing(scenes, [light, heavy], tmp_path / "local", log=_quiet)
     processes = run_missing(scenes, [light, heavy], tmp_path / "processes", log=_quiet,
                             execute=make_executor("processes", cpus=2))
@@ -78,9 +88,7 @@ def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path
     for cores, expect_here in ((1.0, False), (2.0, True)):
         pids = tmp_path / f"pids-{cores}"
         pids.mkdir()
-        spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
-                       run=partial(_2ds_noting_its_process, str(pids)),
-                       resources=TaskResources(cpus=cores))
+        spec = _heavy_2ds(tmp_path, cores, run=partial(_2ds_noting_its_process, str(pids)))
         outcomes = run_missing(scenes, [spec], tmp_path / f"results-{cores}", log=_quiet,
                                execute=make_executor("auto", cpus=2))
         assert [o.status for o in outcomes] == ["ran"] * 3
@@ -91,8 +99,7 @@ def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path
 @pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
     scenes = find_scenes(tiny_benchmark)
-    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
-                   run=_dies_on_first_scene)
+    spec = _heavy_2ds(tmp_path, run=_dies_on_first_scene)
     messages = []
     outcomes = run_missing(scenes, [spec], tmp_path / "results", log=messages.append,
                            execute=make_executor("processes", cpus=2))
@@ -109,8 +116,7 @@ def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
 @pytest.mark.slow
 def test_a_heavy_run_s_progress_is_shown_by_the_parent(tiny_benchmark, tmp_path, capsys):
     scenes = find_scenes(tiny_benchmark)[:2]
-    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
-                   run=_2ds_after_a_counted_loop)
+    spec = _heavy_2ds(tmp_path, run=_2ds_after_a_counted_loop)
     outcomes = run_missing(scenes, [spec], tmp_path / "results", log=_quiet,
                            execute=make_executor("processes", cpus=2))
     assert [o.status for o in outcomes] == ["ran"] * 2
