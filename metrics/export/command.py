@@ -19,7 +19,11 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
+from dataset.benchmark_cache import (
+    DefaultBenchmark,
+    benchmark_of_results,
+    default_results_folder,
+)
 from envelope.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.footprint import geojson_to_polygon
@@ -231,10 +235,10 @@ def _paths(args: argparse.Namespace) -> tuple[Path, Path | None, Path]:
     if results is None:
         folder = DefaultBenchmark().folder
         results, data = default_results_folder(folder), data or folder
-    if data is None and results.name.endswith("-results"):
-        guess = results.with_name(results.name.removesuffix("-results"))
-        data = guess if guess.is_dir() else None
-    stem = results.name.removesuffix("-results")
+    guess = benchmark_of_results(results)
+    if data is None and guess is not None and guess.is_dir():
+        data = guess
+    stem = results.name if guess is None else guess.name
     out = args.out or results.with_name(f"{stem}-export")
     return results, data, out
 

@@ -9,7 +9,11 @@ import pytest
 
 import baselines.cli
 from baselines import wwr2ds, wwr2dss
-from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
+from dataset.benchmark_cache import (
+    DefaultBenchmark,
+    benchmark_of_results,
+    default_results_folder,
+)
 from envelope.method import available_methods
 from envelope.results import MethodResult, read_result
 from envelope.scenes.scene import find_scene_folders
@@ -17,10 +21,24 @@ from envelope.truth import read_building
 from metrics.run.compare_args import compare_request, parse_compare_args
 
 
-def test_default_results_folder(tmp_path):
+def test_one_default_results_folder_for_every_command(tmp_path):
+    """The 2D command lines, compare and export all name a benchmark's results folder by
+    dataset.benchmark_cache.default_results_folder (export also reads it backwards)."""
+    from metrics.export.command import _parse_args, _paths
+
     bench = tmp_path / "bench"
+    bench.mkdir()
     assert default_results_folder(bench) == tmp_path / "bench-results"
     assert default_results_folder(bench / "a") == bench / "a-results"
+    assert benchmark_of_results(default_results_folder(bench)) == bench
+    assert benchmark_of_results(tmp_path / "results") is None
+    methods = available_methods()
+    request = compare_request(parse_compare_args(["--data", str(bench)], methods), methods)
+    assert request.results == default_results_folder(bench)
+    results, data, out = _paths(_parse_args(["--results", str(request.results)]))
+    assert (results, data, out) == (request.results, bench, tmp_path / "bench-export")
+    default = DefaultBenchmark().folder
+    assert _paths(_parse_args([]))[:2] == (default_results_folder(default), default)
 
 
 @pytest.mark.slow
