@@ -263,7 +263,8 @@ def main(argv: list[str] | None = None) -> int:
             raise ValueError(f"--max-minutes must be > 0, got {args.max_minutes}")
         check_output_folder(args.out)
         max_s = None if args.max_minutes is None else 60.0 * args.max_minutes
-        print(train(read_method_input(args.scene), config, args.out, device=args.device,
+        device = resolve_device(args.device)
+        print(train(read_method_input(args.scene), config, args.out, device=device,
                     resume=args.resume, max_seconds=max_s))
         return 0
 
