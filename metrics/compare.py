@@ -29,6 +29,7 @@ from dataset.benchmark_cache import ensure_benchmark
 from envelope.cli_errors import check_output_folder, exit_cli, run_cli
 from envelope.executors.ray_tasks import RayConfig
 from envelope.method import available_methods
+from envelope.scenes.scene import find_scene_folders
 from metrics.comparison import PROVENANCE_FILE, compare
 from metrics.predicted_masks import compare_on_predicted_masks
 from metrics.report.tables import to_text
@@ -39,7 +40,7 @@ from metrics.run.executors import make_executor
 from metrics.run.explain import explain, recorded_steps
 from metrics.run.methods import list_methods, method_specs
 from metrics.run.predicted_masks import masks_segmenter
-from metrics.run.runner import Execute, MethodSpec, execute_local, find_scenes
+from metrics.run.runner import Execute, MethodSpec, execute_local
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -129,7 +130,7 @@ def robustness_study(request: CompareRequest, study: RobustnessStudy, *,
 
 def explain_one(request: CompareRequest, scene: str, method: str) -> int:
     """``--explain SCENE METHOD``: print one scene's result records of one method."""
-    scene_dir = next((d for d in find_scenes(request.data) if d.name == scene), None)
+    scene_dir = next((d for d in find_scene_folders(request.data) if d.name == scene), None)
     if scene_dir is None:
         raise ValueError(f"no scene {scene!r} in {request.data}")
     for spec in method_specs((method,), request.views, request.results,

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from envelope.atomic import write_json_atomic, write_text_atomic
 from envelope.results import code_version
+from envelope.scenes.scene import find_scene_folders
 from envelope.truth import BuildingTruth, read_building
 from metrics.report.compare_outputs import (
     keep_pipeline_images,
@@ -53,7 +54,7 @@ from metrics.report.report_visible import TABLE2_VISIBLE_NAME, table2_visible_er
 from metrics.report.tables import Table, to_csv, write_table
 from metrics.run.explain import methods_provenance_text, run_timings
 from metrics.run.mesh_pointers import write_mesh_pointers
-from metrics.run.runner import Execute, MethodSpec, Outcome, execute_local, find_scenes, run_missing
+from metrics.run.runner import Execute, MethodSpec, Outcome, execute_local, run_missing
 from metrics.score.aggregate import GroupSummary, aggregate_by_family
 from metrics.score.errors import (
     NO_TRUTH_FAMILY,
@@ -117,7 +118,7 @@ def compare(
     ValueError
         If ``data`` holds no scene folder.
     """
-    scene_dirs = find_scenes(data)
+    scene_dirs = find_scene_folders(data)
     outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run,
                            reuse_stale=reuse_stale, execute=execute)
     truths = {d.name: _read_truth(d) for d in scene_dirs}

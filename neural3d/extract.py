@@ -53,8 +53,8 @@ from neural3d.extraction.meshing import (
     extract_mesh,
 )
 from neural3d.extraction.straight_walls import straighten_footprint
+from neural3d.method import METHOD_NEURAL3D
 
-METHOD = "neural3d"
 PROTOCOL = TRAIN_PROTOCOL
 
 
@@ -186,7 +186,7 @@ def measure_mesh(trained, mesh: SemanticMesh, config: ExtractConfig, *, device: 
         footprint = None
         warnings.append(f"no footprint: {exc}")
     return MethodResult(
-        scene=trained.scene_name, method=METHOD, protocol=PROTOCOL, wwr=m.wwr,
+        scene=trained.scene_name, method=METHOD_NEURAL3D.name, protocol=PROTOCOL, wwr=m.wwr,
         window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
         footprint=footprint, config=asdict(config), code_version=code_version(),
         facade_identity="geometry",
@@ -210,13 +210,24 @@ def extract_run(
     that evaluation step (its snapshot) instead of the checkpoint's. Everything
     is computed before anything is written, and each file is written atomically.
     """
-    from neural3d.field.trained import load_trained_field
-
     run_dir = Path(run_dir)
-    if not run_dir.is_dir():
-        raise ValueError(f"run folder {run_dir} does not exist")
     if out_dir is None:
         out_dir = run_dir / "extract" if step is None else run_dir / "extract" / f"step_{step}"
+    result = measure_run(run_dir, config=config, device=device, out_dir=Path(out_dir),
+                         progress=progress, step=step)
+    write_result(out_dir, result)
+    return result
+
+
+def measure_run(run_dir: Path, *, config: ExtractConfig, device: torch.device, out_dir: Path,
+                progress: bool = False, step: int | None = None) -> MethodResult:
+    """:func:`extract_run` without the result file: writes ``mesh.ply`` and
+    ``footprint.geojson`` into ``out_dir`` and returns the result (the comparison writes it
+    once, with its provenance, into its results folder)."""
+    from neural3d.field.trained import load_trained_field
+
+    if not Path(run_dir).is_dir():
+        raise ValueError(f"run folder {run_dir} does not exist")
     out_dir = Path(out_dir)
     try:
         trained = load_trained_field(run_dir, device=device, step=step)
@@ -232,7 +243,6 @@ def extract_run(
         write_json_atomic(footprint_path, result.footprint)
     else:  # a footprint from an earlier extraction would contradict this result
         footprint_path.unlink(missing_ok=True)
-    write_result(out_dir, result)
     return result
 
 

@@ -25,7 +25,8 @@ from tqdm import tqdm
 
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.scenes.images import write_labels
-from segment.scene_masks import predicted_scene, scene_folders
+from envelope.scenes.scene import find_scene_folders
+from segment.scene_masks import predicted_scene
 from segment.segmenter import Segmenter, resolve_segmenter, segment_photo
 
 PHOTO_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp")
@@ -101,10 +102,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     def body() -> int:
         if args.photos is not None:
             return photos_body()
-        dirs = scene_folders(args.data)
-        if not dirs:
-            raise ValueError(f"--data {args.data} holds no scene folder (one with "
-                             f"transforms.json)")
+        dirs = find_scene_folders(args.data, with_images=True)
         check_output_folder(args.out)
         if args.out.resolve() in {d.resolve().parent for d in dirs}:
             raise ValueError(f"--out {args.out} holds the scenes themselves; choose another "

@@ -44,19 +44,6 @@ RECORD_KEY = "predicted_masks"
 SEMANTICS_FOLDER = "semantics"
 
 
-def scene_folders(folder: str | Path) -> list[Path]:
-    """``folder`` if it is a scene folder (has ``transforms.json``), else its sub-folders
-    that are (not hidden ones: unfinished copies), sorted; ``[]`` if none or if
-    ``folder`` is no folder."""
-    folder = Path(folder)
-    if (folder / "transforms.json").is_file():
-        return [folder]
-    if not folder.is_dir():
-        return []
-    return sorted(d for d in folder.iterdir()
-                  if not d.name.startswith(".") and (d / "transforms.json").is_file())
-
-
 def masks_provenance(segmenter: Segmenter, source_dir: str | Path,
                      splits: Collection[str] | None = None) -> Provenance:
     """The record a mask copy of ``source_dir`` made by ``segmenter`` carries (``splits``:

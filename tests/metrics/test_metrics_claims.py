@@ -104,11 +104,18 @@ def test_paper_figures_sit_beside_ours_where_the_paper_has_the_row():
 
 
 def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
+    from dataclasses import dataclass
+
+    from envelope.scenes.scene import find_scene_folders
     from envelope.truth import write_building
-    from metrics.run.runner import MethodSpec, find_scenes, run_missing
+    from metrics.run.runner import folder_spec, run_missing
+
+    @dataclass(frozen=True)
+    class Seeded:
+        seed: int
 
     write_building(tmp_path / "data" / "a" / "building.json", make_truth("a"))
-    scenes = find_scenes(tmp_path / "data")
+    scenes = find_scene_folders(tmp_path / "data")
     calls = []
 
     def run(scene_dir, protocol, seed):
@@ -116,7 +123,7 @@ def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
         return replace(make_result("a", "fake", protocol, 0.25 + seed / 100),
                        config={"seed": seed})
 
-    specs = [MethodSpec("fake", ("train",), {"seed": s}, lambda d, p, s=s: run(d, p, s), seed=s)
+    specs = [folder_spec("fake", ("train",), Seeded(s), lambda d, p, s=s: run(d, p, s))
              for s in (0, 1)]
     out = run_missing(scenes, specs, tmp_path / "results", log=lambda _: None)
     assert [(o.status, o.result.seed) for o in out] == [("ran", 0), ("ran", 1)]

@@ -15,6 +15,7 @@ import neural3d.field.trained
 from envelope.classes import CLASS_NAMES
 from envelope.footprint import geojson_to_polygon
 from envelope.results import read_result, result_filename
+from envelope.scenes.scene import read_method_input
 from envelope.semantic_ply import read_semantic_ply
 from envelope.truth import FacadeTruth
 from metrics.score.errors import facade_errors
@@ -161,7 +162,7 @@ def test_extract_run_on_a_trained_run(box_building, tmp_path):
 
     scene = write_ring_scene(box_building, tmp_path / "box", size_px=24, n_train=8, n_eval=0)
     config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
-    run_dir = train(scene, config, tmp_path / "runs", device=torch.device("cpu"))
+    run_dir = train(read_method_input(scene), config, tmp_path / "runs", device=torch.device("cpu"))
     out = tmp_path / "out"
     assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out),
                  "--without", "occluded_fill,roofed_hole_fill"]) == 0
