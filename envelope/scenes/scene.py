@@ -1,5 +1,5 @@
 """A scene folder's ``transforms.json`` read into a :class:`~envelope.scene_record.Scene` and
-written back (DESIGN.md).
+written back (docs/DESIGN.md).
 
 Methods read scenes through :func:`read_method_input`, which never opens ``building.json``;
 :func:`read_scene` (the truth too) is for the dataset's tools and for metrics. Every command
