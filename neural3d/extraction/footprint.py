@@ -25,7 +25,7 @@ vertical lines from the highest plane to the box top, at up to
 one sample per ``cell_m``: a line meets a surface where some sample is within
 half a cell of it (|SDF| <= cell_m / 2, or inside). A hole where most lines
 meet a surface is roofed over and is filled. This assumes no building has a
-roofed hole in its footprint at 1-4 m: a covered passage or a glass-roofed
+roofed hole in its footprint at 1-2.5 m: a covered passage or a glass-roofed
 courtyard would be filled (footprint biased high).
 """
 
