@@ -122,7 +122,7 @@ def test_evaluation_matches_the_own_facades_to_the_truth(scene_dir):
 
 
 @pytest.mark.slow
-def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
+def test_extract_run_writes_four_files(scene_dir, tmp_path, monkeypatch):
     monkeypatch.setattr(neural3d.field.trained, "load_trained_field",
                         lambda run_dir, device, step=None: AnalyticField(scene_dir))
     run_dir = tmp_path / "run"
@@ -134,6 +134,9 @@ def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
     assert len(f) > 1000 and set(np.unique(labels)) <= {0, 1, 2, 3}
     poly = geojson_to_polygon(json.loads((out / "footprint.geojson").read_text()))
     assert poly.area == pytest.approx(24.0, rel=0.01)
+    # a box: its widest outline is its footprint
+    widest = geojson_to_polygon(json.loads((out / "footprint_widest.geojson").read_text()))
+    assert widest.symmetric_difference(poly).area < 0.01 * poly.area
 
 
 def test_cli_errors_are_one_line(tmp_path, capsys):
