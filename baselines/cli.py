@@ -1,4 +1,4 @@
-"""What the 2D-S and 2D-SS command lines share: finding scenes, the results folder, the loop,
+"""What the 2D-S and 2D-SS command lines share: the benchmark, the results folder, the loop,
 and the table of what was measured.
 
 ``--data`` is one scene folder (with ``transforms.json``) or a folder of scene
@@ -24,31 +24,8 @@ from envelope.cli_errors import add_debug_flag, check_output_folder, one_line, r
 from envelope.method_input import MethodInput
 from envelope.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
 from envelope.results import MethodResult, write_result
-from envelope.scenes.scene import read_method_input
+from envelope.scenes.scene import find_scene_folders, read_method_input
 from envelope.warnings_summary import summarise_warnings
-
-
-def scene_folders(data: Path) -> list[Path]:
-    """The scene folders named by ``--data``, sorted by name.
-
-    Raises
-    ------
-    ValueError
-        If ``data`` is neither a scene folder nor holds any.
-    """
-    data = Path(data)
-    if (data / "transforms.json").is_file():
-        return [data]
-    if not data.is_dir():
-        raise ValueError(f"--data {data} does not exist")
-    scenes = sorted(p for p in data.iterdir()
-                    if not p.name.startswith(".") and (p / "transforms.json").is_file())
-    if not scenes:
-        raise ValueError(
-            f"--data {data} is neither a scene folder (with transforms.json) nor a folder of "
-            "scene folders; make one with `python -m dataset.generate`"
-        )
-    return scenes
 
 
 def benchmark_folder(data: Path | None) -> Path:
@@ -120,7 +97,7 @@ def run_scenes(data: Path | None, out: Path | None,
         If ``data`` holds no scene or no scene could be measured.
     """
     data = benchmark_folder(data)
-    folders = scene_folders(data)
+    folders = find_scene_folders(data, with_images=True)
     out = check_output_folder(default_results_folder(data) if out is None else Path(out))
     written, failures = 0, []
     for folder in tqdm(folders, desc="scenes", unit="scene", disable=len(folders) < 2):

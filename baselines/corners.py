@@ -22,6 +22,7 @@ import cv2
 import numpy as np
 
 from baselines.views import ViewError
+from envelope.polygons import polygon_area
 
 _SIDE_BAND_PX = 2.0  # contour pixels within this distance inside a side belong to it
 _SIDE_MIDDLE = (0.1, 0.9)  # part of a side used for the refit (corners are rounded)
@@ -40,7 +41,7 @@ def enclosing_quadrilateral(mask: np.ndarray) -> np.ndarray:
     """
     contour = outer_contour_uv(mask)
     hull = cv2.convexHull(contour.astype(np.float32)).reshape(-1, 2).astype(np.float64)
-    if len(hull) < 4 or _polygon_area(hull) < 4.0:
+    if len(hull) < 4 or polygon_area(hull) < 4.0:
         raise ViewError("the facade mask is too small to have four corners")
     quad = minimum_area_quadrilateral(hull)
     quad = _refine_sides(quad, contour)
@@ -184,7 +185,3 @@ def _intersect_lines(l1, l2):
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
-
-
-def _polygon_area(p: np.ndarray) -> float:
-    return 0.5 * abs(float(np.sum(_cross(p, np.roll(p, -1, 0)))))

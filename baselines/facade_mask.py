@@ -1,6 +1,6 @@
 """Which pixels of a view belong to the photographed facade.
 
-facade = wall | window | door pixels (DESIGN.md). A natural view often shows a
+facade = wall | window | door pixels (docs/DESIGN.md). A natural view often shows a
 neighbouring facade too, joined to the target along the building corner.
 Occluders in front of a facade (class "other": balconies, railings) must not
 split it: connectivity is taken over facade | other pixels, and the result

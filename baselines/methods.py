@@ -1,9 +1,14 @@
-"""2D-S and 2D-SS as benchmark methods (:class:`envelope.method.Method`)."""
+"""2D-S and 2D-SS as benchmark methods (:class:`envelope.method.Method`).
+
+Each takes its name from the module that makes its results (``METHOD``), so that the
+name its results carry, and hence their file names, is its ``Method.name``.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from baselines import wwr2ds, wwr2dss
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
 from envelope.method import Method
@@ -21,14 +26,14 @@ def debug_images_2dss(scene: MethodInput, protocol: str, config: Wwr2dssConfig,
 
 
 METHOD_2DS = Method(
-    name="2D-S", inputs=("semantics", "depth", "poses"), protocols=PROTOCOLS_2D,
+    name=wwr2ds.METHOD, inputs=("semantics", "depth", "poses"), protocols=PROTOCOLS_2D,
     config_type=Wwr2dsConfig, run=run_2ds, packages=("baselines",), libraries=LIBRARIES,
     description="per-view window/facade pixel ratio of the semantic mask (Szczesniak et al.); "
                 "on views without facade ids, views grouped by their dominant depth plane",
     paper_name="2D-S",
 )
 METHOD_2DSS = Method(
-    name="2D-SS", inputs=("rgb", "semantics", "depth", "poses"), protocols=PROTOCOLS_2D,
+    name=wwr2dss.METHOD, inputs=("rgb", "semantics", "depth", "poses"), protocols=PROTOCOLS_2D,
     config_type=Wwr2dssConfig, run=run_2dss, packages=("baselines",), libraries=LIBRARIES,
     description="facade plane by RANSAC, rectified facade, WWR in the rectified mask; on views "
                 "without facade ids, own facades from depth planes measured by cell voting",

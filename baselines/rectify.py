@@ -18,6 +18,7 @@ import torch
 from kornia.geometry.transform import get_perspective_transform, warp_perspective
 
 from envelope.classes import SemanticClass
+from envelope.polygons import polygon_area
 from envelope.wwr import wwr_from_areas
 
 OUTSIDE = 255  # label of rectified-canvas pixels outside the facade rectangle
@@ -44,8 +45,7 @@ def quadrilateral_area_px(corners_uv: np.ndarray) -> float:
     c = np.asarray(corners_uv, dtype=np.float64)
     if c.shape != (4, 2):
         raise ValueError(f"corners must be (4, 2), got {c.shape}")
-    x, y = c[:, 0], c[:, 1]
-    return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    return polygon_area(c)
 
 
 def rectified_from_image(corners_uv: np.ndarray, sizes_px: np.ndarray) -> torch.Tensor:

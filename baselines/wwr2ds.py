@@ -36,7 +36,7 @@ from envelope.results import FacadeEstimate, MethodResult
 from envelope.scene_record import scene_name
 from envelope.wwr import wwr_from_areas
 
-METHOD = "2D-S"
+METHOD = "2D-S"  # its name, spelled only here: its Method (baselines.methods) takes it
 
 
 @dataclass(frozen=True)

@@ -71,7 +71,7 @@ from envelope.results import FacadeEstimate, MethodResult
 from envelope.scene_record import scene_name
 from envelope.scenes.images import read_rgb
 
-METHOD = "2D-SS"
+METHOD = "2D-SS"  # its name, spelled only here: its Method (baselines.methods) takes it
 
 
 @dataclass(frozen=True)

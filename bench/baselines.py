@@ -35,7 +35,6 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
-from baselines.cli import scene_folders  # noqa: E402
 from baselines.views import load_views  # noqa: E402
 from baselines.wwr2ds import Wwr2dsConfig, measure_view_2ds, run_2ds  # noqa: E402
 from baselines.wwr2dss import (  # noqa: E402
@@ -47,7 +46,11 @@ from baselines.wwr2dss import (  # noqa: E402
 from envelope.atomic import write_text_atomic  # noqa: E402
 from envelope.method_input import MethodInput  # noqa: E402
 from envelope.protocols import VIEW_PROTOCOLS  # noqa: E402
-from envelope.scenes.scene import read_method_input, read_scene  # noqa: E402
+from envelope.scenes.scene import (  # noqa: E402
+    find_scene_folders,  # noqa: E402
+    read_method_input,
+    read_scene,
+)
 from metrics.report.report import table2_errors  # noqa: E402
 from metrics.report.tables import to_markdown  # noqa: E402
 from metrics.score.aggregate import aggregate_by_family  # noqa: E402
@@ -147,7 +150,7 @@ def _tiny_preset(root: Path) -> list[Path]:
         warnings.simplefilter("ignore", UserWarning)
         generate_preset("tiny", root, GenerateConfig(resolution=SPEED_SIZE, views=4),
                         progress=False)
-    return scene_folders(root)
+    return find_scene_folders(root, with_images=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -163,7 +166,8 @@ def main(argv: list[str] | None = None) -> int:
         torch.set_num_threads(args.threads)
     with tempfile.TemporaryDirectory(prefix="bench_baselines_") as tmp:
         try:
-            folders = scene_folders(args.data) if args.data else _tiny_preset(Path(tmp))
+            folders = (find_scene_folders(args.data, with_images=True) if args.data
+                       else _tiny_preset(Path(tmp)))
             speed_scenes = _scenes_at(folders, SPEED_SIZE)
             if not speed_scenes:
                 speed_scenes = _scenes_at(_tiny_preset(Path(tmp) / "tiny512"), SPEED_SIZE)

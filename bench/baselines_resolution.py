@@ -27,7 +27,6 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
 from dataset.rendering.render import Raycaster, render_ground_truth  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
@@ -36,7 +35,12 @@ from envelope.method_input import MethodInput  # noqa: E402
 from envelope.protocols import VIEW_PROTOCOLS  # noqa: E402
 from envelope.scene_record import Frame, Scene  # noqa: E402
 from envelope.scenes.images import write_depth_m, write_labels  # noqa: E402
-from envelope.scenes.scene import read_method_input, read_scene, write_transforms  # noqa: E402
+from envelope.scenes.scene import (  # noqa: E402
+    find_scene_folders,  # noqa: E402
+    read_method_input,
+    read_scene,
+    write_transforms,
+)
 from metrics.score.errors import building_errors  # noqa: E402
 
 
@@ -74,8 +78,9 @@ def main(argv: list[str] | None = None) -> int:
         if min(factors) < 1:
             raise ValueError("factors must be integers >= 1")
         config = Wwr2dssConfig(max_rectified_px=args.max_rectified_px)
-        refuse_report_only(scene_folders(args.data), "choose 2D-SS's resolution")
-        folders = [f for f in scene_folders(args.data)
+        refuse_report_only(find_scene_folders(args.data, with_images=True),
+                           "choose 2D-SS's resolution")
+        folders = [f for f in find_scene_folders(args.data, with_images=True)
                    if getattr(read_scene(f).building, "type", None) == args.family]
         if not folders:
             raise ValueError(f"no scene of family {args.family!r} in {args.data}")

@@ -45,10 +45,17 @@ from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
 from envelope.atomic import write_text_atomic  # noqa: E402
 from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
 from envelope.results import MethodResult  # noqa: E402
-from metrics.compare import compare  # noqa: E402
+from envelope.scenes.scene import find_scene_folders  # noqa: E402
+from metrics.comparison import compare  # noqa: E402
 from metrics.run.executors import make_executor  # noqa: E402
 from metrics.run.methods import method_specs  # noqa: E402
-from metrics.run.runner import Job, MethodSpec, find_scenes, run_job, run_missing  # noqa: E402
+from metrics.run.runner import (  # noqa: E402
+    Job,
+    MethodSpec,
+    folder_spec,
+    run_job,
+    run_missing,
+)
 from neural3d.method import Neural3dBudget  # noqa: E402
 
 NODES = (1, 2, 4, 8, 16, 32, 64)
@@ -58,7 +65,7 @@ def _noop_spec() -> MethodSpec:
     def run(scene_dir: Path, protocol: str) -> MethodResult:
         return MethodResult(scene_dir.name, "noop", protocol, None, None, None)
 
-    return MethodSpec("noop", ("ideal",), {}, run)
+    return folder_spec("noop", ("ideal",), {}, run)
 
 
 def time_comparisons(data: Path, specs_for, tmp: Path, ray: RayConfig) -> dict:
@@ -86,7 +93,7 @@ def time_comparisons(data: Path, specs_for, tmp: Path, ray: RayConfig) -> dict:
 
 def time_overhead(data: Path, tmp: Path, repeat: int = 5) -> dict:
     """Seconds per no-op job through the Ray executor: alone (latency) and many at once."""
-    scenes = find_scenes(data)
+    scenes = find_scene_folders(data)
     spec = _noop_spec()
     execute = make_executor("ray", RayConfig())
     latencies = []
@@ -213,7 +220,7 @@ def main(argv: list[str] | None = None) -> int:
         measured = time_comparisons(data, specs_for, tmp, RayConfig(num_cpus=args.cpus))
         load = " / ".join(f"{x:.1f}" for x in os.getloadavg())
         text = report(measured, methods, specs_for(tmp / "r"), args.buildings, args.node_cpus,
-                      len(find_scenes(data)), load)
+                      len(find_scene_folders(data)), load)
     if measured["failed"]:
         text += f"\n**{measured['failed']} runs failed**; the figures above are not comparable.\n"
     print(text)

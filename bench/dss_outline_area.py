@@ -21,10 +21,13 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import numpy as np  # noqa: E402
 
-from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
-from envelope.scenes.scene import read_method_input, read_scene  # noqa: E402
+from envelope.scenes.scene import (  # noqa: E402
+    find_scene_folders,  # noqa: E402
+    read_method_input,
+    read_scene,
+)
 from metrics.score.errors import building_errors  # noqa: E402
 
 
@@ -34,14 +37,15 @@ def main() -> None:
     p.add_argument("--views", default="ideal,multi")
     args = p.parse_args()
     try:
-        refuse_report_only(scene_folders(args.data), "choose 2D-SS's facade-area rule")
+        refuse_report_only(find_scene_folders(args.data, with_images=True),
+                           "choose 2D-SS's facade-area rule")
     except ValueError as exc:
         p.error(str(exc))
     configs = {"L x H": replace(Wwr2dssConfig(), min_rectangle_fill=0.0),
                "outline": Wwr2dssConfig()}
     totals: dict[tuple[str, str], list[tuple[float, float, float]]] = {}
     print(f"{'scene':22s} {'views':6s} {'variant':8s} facade% window%   WWR%")
-    for folder in scene_folders(args.data):
+    for folder in find_scene_folders(args.data, with_images=True):
         truth, scene = read_scene(folder).building, read_method_input(folder)
         for protocol in args.views.split(","):
             for name, config in configs.items():

@@ -48,17 +48,19 @@ CPU = torch.device("cpu")
 def trained_run(scene_dir: Path, config: TrainConfig, out_dir: Path) -> tuple[Path, float]:
     """(run folder, training seconds) of ``config`` on ``scene_dir``: trained now, or reused
     when ``out_dir`` already holds that run finished with the same config."""
+    from envelope.scenes.scene import read_method_input
     from neural3d.train import train
     from neural3d.training.run_folder import read_run_config
 
+    scene = read_method_input(scene_dir)
     run_dir = out_dir / scene_dir.name
     checkpoint = run_dir / CHECKPOINT_NAME
     if not (checkpoint.is_file() and config_to_dict(read_run_config(run_dir))
             == config_to_dict(config)):
-        run_dir = train(scene_dir, config, out_dir, device=CPU)
+        run_dir = train(scene, config, out_dir, device=CPU)
     state = read_checkpoint(checkpoint, CPU)
     if int(state["step"]) < config.iterations:
-        run_dir = train(scene_dir, config, out_dir, device=CPU, resume=True)
+        run_dir = train(scene, config, out_dir, device=CPU, resume=True)
         state = read_checkpoint(checkpoint, CPU)
     return run_dir, float(state["train_s"])
 

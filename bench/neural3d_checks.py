@@ -37,6 +37,7 @@ from bench.neural3d import (  # noqa: E402  the targets and the spread, defined 
     last_checks_spread,
     on_target,
 )
+from bench.tables import markdown_table  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
 from envelope.atomic import write_json_atomic  # noqa: E402
 from envelope.results import code_version  # noqa: E402
@@ -100,23 +101,25 @@ def _fmt(value: float | None, digits: int) -> str:
 
 
 def markdown(buildings: list[dict], curves: dict[str, list[dict]]) -> str:
-    lines = ["| building | family | steps checked | final WWR error % | final IoU | "
-             "WWR spread, last 3 (pts) | IoU spread, last 3 |", "|---|---|---|---|---|---|---|"]
+    per_building = []
     for b in buildings:
         final = b["checks"][-1] if b["checks"] else {}
         sp = b["last3_spread"]
-        lines.append(f"| {b['scene']} | {b['family']} | "
-                     f"{','.join(str(r['step']) for r in b['checks'])} | "
-                     f"{_fmt(final.get('wwr_ape'), 2)} | {_fmt(final.get('footprint_iou'), 3)} | "
-                     f"{_fmt(sp['wwr_ape'], 2)} | {_fmt(sp['footprint_iou'], 3)} |")
-    lines += ["", "| family | step | mean training min | mean WWR error % | mean IoU | "
-              "on target |", "|---|---|---|---|---|---|"]
-    for family, curve in curves.items():
-        for c in curve:
-            lines.append(f"| {family} | {c['step']} | {_fmt(c['train_min'], 1)} | "
-                         f"{_fmt(c['wwr_ape'], 2)} | {_fmt(c['footprint_iou'], 3)} | "
-                         f"{c['on_target']}/{c['buildings']} |")
-    return "\n".join(lines)
+        per_building.append([
+            b["scene"], b["family"], ",".join(str(r["step"]) for r in b["checks"]),
+            _fmt(final.get("wwr_ape"), 2), _fmt(final.get("footprint_iou"), 3),
+            _fmt(sp["wwr_ape"], 2), _fmt(sp["footprint_iou"], 3)])
+    per_check = [[family, c["step"], _fmt(c["train_min"], 1), _fmt(c["wwr_ape"], 2),
+                  _fmt(c["footprint_iou"], 3), f"{c['on_target']}/{c['buildings']}"]
+                 for family, curve in curves.items() for c in curve]
+    return "\n\n".join([
+        markdown_table("Per building: the last check, and the spread of the last three",
+                       ["building", "family", "steps checked", "final WWR error %",
+                        "final IoU", "WWR spread, last 3 (pts)", "IoU spread, last 3"],
+                       per_building),
+        markdown_table("Per family and check", ["family", "step", "mean training min",
+                                                "mean WWR error %", "mean IoU", "on target"],
+                       per_check)])
 
 
 def plot(curves: dict[str, list[dict]], path: Path, title: str) -> None:

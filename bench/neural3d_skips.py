@@ -33,6 +33,7 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 import torch  # noqa: E402
 
 from bench.neural3d import training_state, with_overrides  # noqa: E402
+from bench.tables import markdown_table  # noqa: E402
 from envelope.atomic import write_json_atomic  # noqa: E402
 from neural3d.config import preset_config  # noqa: E402
 from neural3d.rendering.neus import edge_alpha, neus_alpha, weights_from_alpha  # noqa: E402
@@ -133,14 +134,14 @@ def main(argv: list[str] | None = None) -> int:
             state.step(i)
     print(f"{args.scene.name}, fast{' ' + ' '.join(args.set) if args.set else ''}, "
           f"{args.steps} steps\n")
-    print("| step | rays hit | heavy share | " + " | ".join(
-        f"guess {g:g}: kept, recall, weight dropped" for g in args.guesses) + " |")
-    print("|---|---|---|" + "---|" * len(args.guesses))
-    for c in checks:
-        cells = [f"{c[f'guess {g:g}']['kept_share']:.3f}, {c[f'guess {g:g}']['recall']:.4f}, "
-                 f"{c[f'guess {g:g}']['weight_dropped_share']:.1e}" for g in args.guesses]
-        print(f"| {c['step']} | {c['rays_hit']} | {c['heavy_share']:.3f} | "
-              + " | ".join(cells) + " |")
+    rows = [[c["step"], c["rays_hit"], f"{c['heavy_share']:.3f}", *[
+        f"{c[f'guess {g:g}']['kept_share']:.3f}, {c[f'guess {g:g}']['recall']:.4f}, "
+        f"{c[f'guess {g:g}']['weight_dropped_share']:.1e}" for g in args.guesses]]
+        for c in checks]
+    print(markdown_table(
+        "Samples guessed light, at each check",
+        ["step", "rays hit", "heavy share",
+         *(f"guess {g:g}: kept, recall, weight dropped" for g in args.guesses)], rows))
     if refreshes:
         shares = sorted(r["query_share"] for r in refreshes)
         print(f"\nblock-first refresh: {len(refreshes)} refreshes, "

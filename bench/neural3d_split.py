@@ -28,6 +28,7 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import torch  # noqa: E402
 
+from bench.tables import markdown_table  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
 from envelope.atomic import write_json_atomic  # noqa: E402
 from envelope.results import code_version  # noqa: E402
@@ -67,25 +68,22 @@ def compare_splits(run_dir: Path, extract: ExtractConfig) -> dict:
 
 def markdown(rows: list[dict]) -> str:
     """Per building and per family mean: window bias, window / facade / WWR APE of each split."""
-    head = "| building | " + " | ".join(
-        f"{s}: window bias / window / facade / WWR %" for s in SPLITS) + " |"
-    lines = [head, "|---|" + "---|" * len(SPLITS)]
-
-    def cells(entries: list[dict]) -> str:
+    def cells(entries: list[dict]) -> list[str]:
         out = []
         for s in SPLITS:
             mean = {k: statistics.mean(e[s][k] for e in entries)
                     for k in ("window_bias_pct", "window_ape", "facade_ape", "wwr_ape")}
             out.append(f"{mean['window_bias_pct']:+.2f} / {mean['window_ape']:.2f} / "
                        f"{mean['facade_ape']:.2f} / {mean['wwr_ape']:.2f}")
-        return " | ".join(out)
+        return out
 
-    for r in rows:
-        lines.append(f"| {r['scene']} | {cells([r])} |")
+    table = [[r["scene"], *cells([r])] for r in rows]
     for family in sorted({r["family"] for r in rows}, key=str):
         members = [r for r in rows if r["family"] == family]
-        lines.append(f"| **{family} ({len(members)})** | {cells(members)} |")
-    return "\n".join(lines)
+        table.append([f"**{family} ({len(members)})**", *cells(members)])
+    return markdown_table(
+        "Window area by labels or by probabilities, per building and per family (mean)",
+        ["building", *(f"{s}: window bias / window / facade / WWR %" for s in SPLITS)], table)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -40,6 +40,7 @@ if not __package__:
 
 import torch  # noqa: E402
 
+from bench.tables import markdown_table  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
 from envelope.atomic import write_json_atomic  # noqa: E402
 from envelope.results import code_version  # noqa: E402
@@ -143,27 +144,25 @@ def markdown(buildings: list[dict], columns: tuple[Column, ...] = ERROR_COLUMNS)
     WWR / window / facade APE % and footprint IoU; per building also the seconds)."""
     labels = list(buildings[0]["sets"])
     families = sorted({b["family"] for b in buildings}, key=str)
-    lines = [_row("stages", "family (buildings)", [c.header for c in columns]),
-             "|---" * (2 + len(columns)) + "|"]
+    family_rows = []
     for label in labels:
         for family in [*families, None] if len(families) > 1 else families:
             members = [b for b in buildings if family is None or b["family"] == family]
             entries = [b["sets"][label] for b in members]
             name = "all" if family is None else family
-            lines.append(_row(label, f"{name} ({len(members)})", [
-                _cell([_value(e, c) for e in entries], c.digits) for c in columns]))
+            family_rows.append([label, f"{name} ({len(members)})", *[
+                _cell([_value(e, c) for e in entries], c.digits) for c in columns]])
     per_building = (*columns, SECONDS)
-    lines += ["", _row("stages", "building", [c.header for c in per_building]),
-              "|---" * (2 + len(per_building)) + "|"]
-    for label in labels:
-        for b in buildings:
-            lines.append(_row(label, b["scene"], [
-                _cell([_value(b["sets"][label], c)], c.digits) for c in per_building]))
-    return "\n".join(lines)
-
-
-def _row(first: str, second: str, cells: list[str]) -> str:
-    return "| " + " | ".join([first, second, *cells]) + " |"
+    building_rows = [[label, b["scene"], *[
+        _cell([_value(b["sets"][label], c)], c.digits) for c in per_building]]
+        for label in labels for b in buildings]
+    return "\n\n".join([
+        markdown_table("Per family (mean), each stage set",
+                       ["stages", "family (buildings)", *(c.header for c in columns)],
+                       family_rows),
+        markdown_table("Per building, each stage set",
+                       ["stages", "building", *(c.header for c in per_building)],
+                       building_rows)])
 
 
 def differences(saved: dict, buildings: list[dict]) -> tuple[list[str], int]:

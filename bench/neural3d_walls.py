@@ -31,6 +31,7 @@ if not __package__:
 
 import torch  # noqa: E402
 
+from bench.tables import markdown_table  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
 from envelope.atomic import write_json_atomic  # noqa: E402
 from envelope.footprint import geojson_to_polygon, polygon_to_geojson  # noqa: E402
@@ -89,25 +90,23 @@ def markdown(buildings: list[dict]) -> str:
     """Per building the IoU of each column, then per family (and all) mean, lowest and
     the count of buildings each column makes worse than the contour by > WORSE_BY."""
     columns = list(buildings[0]["iou"])
-    lines = ["| building | family | " + " | ".join(columns) + " |",
-             "|---|---|" + "---|" * len(columns)]
-    for b in buildings:
-        lines.append(f"| {b['scene']} | {b['family']} | "
-                     + " | ".join(f"{b['iou'][c]:.4f}" for c in columns) + " |")
-    lines += ["", "| family (buildings) | figure | " + " | ".join(columns) + " |",
-              "|---|---|" + "---|" * len(columns)]
-    families = sorted({b["family"] for b in buildings}) + ["all"]
-    for family in families:
+    per_building = [[b["scene"], b["family"], *(f"{b['iou'][c]:.4f}" for c in columns)]
+                    for b in buildings]
+    per_family = []
+    for family in sorted({b["family"] for b in buildings}) + ["all"]:
         group = [b for b in buildings if family in ("all", b["family"])]
         mean = [statistics.fmean(b["iou"][c] for b in group) for c in columns]
         low = [min(b["iou"][c] for b in group) for c in columns]
         worse = [sum(b["iou"][c] < b["iou"][CONTOUR] - WORSE_BY for b in group)
                  for c in columns]
-        name = f"{family} ({len(group)})"
-        lines.append(f"| {name} | mean | " + " | ".join(f"{v:.4f}" for v in mean) + " |")
-        lines.append("|  | lowest | " + " | ".join(f"{v:.4f}" for v in low) + " |")
-        lines.append(f"|  | worse by > {WORSE_BY} | " + " | ".join(str(v) for v in worse) + " |")
-    return "\n".join(lines)
+        per_family += [[f"{family} ({len(group)})", "mean", *(f"{v:.4f}" for v in mean)],
+                       ["", "lowest", *(f"{v:.4f}" for v in low)],
+                       ["", f"worse by > {WORSE_BY}", *worse]]
+    return "\n\n".join([
+        markdown_table("Footprint IoU per building", ["building", "family", *columns],
+                       per_building),
+        markdown_table("Footprint IoU per family", ["family (buildings)", "figure", *columns],
+                       per_family)])
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -22,12 +22,11 @@ sys.path[0] = str(Path(__file__).resolve().parent.parent)
 
 import numpy as np  # noqa: E402
 
-from baselines.cli import scene_folders  # noqa: E402
 from baselines.wwr2ds import Wwr2dsConfig, run_2ds  # noqa: E402
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss  # noqa: E402
 from dataset.set_roles import refuse_report_only  # noqa: E402
 from envelope.method_input import method_input  # noqa: E402
-from envelope.scenes.scene import read_scene  # noqa: E402
+from envelope.scenes.scene import find_scene_folders, read_scene  # noqa: E402
 from metrics.score.errors import building_errors, facade_errors  # noqa: E402
 
 RUNS = {"2D-SS": lambda s, split: run_2dss(s, split, Wwr2dssConfig()),
@@ -79,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--split", default="train", help="views without facade ids")
     parser.add_argument("--methods", default=",".join(RUNS))
     args = parser.parse_args(argv)
-    scenes = scene_folders(args.data)
+    scenes = find_scene_folders(args.data, with_images=True)
     refuse_report_only(scenes, "bench/own_facades.py chooses the own-facade settings")
     rows = [bench_row(m, s, args.split) for m in args.methods.split(",") for s in scenes]
     print(markdown(rows))

@@ -52,11 +52,23 @@ class DefaultBenchmark:
         )
 
 
+RESULTS_SUFFIX = "-results"
+
+
 def default_results_folder(data: str | Path) -> Path:
     """``<data>-results`` beside ``data`` (a folder of scene folders, or one scene folder),
     ``data`` made absolute: the result files of the methods run on it."""
     data = Path(data).resolve()
-    return data.with_name(f"{data.name}-results")
+    return data.with_name(f"{data.name}{RESULTS_SUFFIX}")
+
+
+def benchmark_of_results(results: str | Path) -> Path | None:
+    """The benchmark folder whose :func:`default_results_folder` is ``results`` (``<X>`` for
+    ``<X>-results``), or ``None`` if ``results`` is not named so."""
+    results = Path(results)
+    if not results.name.endswith(RESULTS_SUFFIX) or results.name == RESULTS_SUFFIX:
+        return None
+    return results.with_name(results.name.removesuffix(RESULTS_SUFFIX))
 
 
 def ensure_benchmark(benchmark: DefaultBenchmark) -> Path:

@@ -20,6 +20,8 @@ from typing import Any
 
 from dataset.importers.import_config import ImportConfig
 from dataset.importers.mesh.building_file import BuildingFileOptions
+from dataset.importers.photos.metric_frame import KnownDistance, ScaleHint
+from dataset.importers.photos.source import PhotosOptions
 from dataset.importers.source import NoOptions, Source, pick_source
 
 _IMPORT_HELP = {
@@ -57,7 +59,8 @@ def add_source_arguments(group: argparse._ActionsContainer, sources: Sequence[So
 
 def add_import_arguments(parser: argparse.ArgumentParser) -> None:
     """One option per :class:`ImportConfig` field (``recentre`` becomes ``--keep-position``)
-    and ``--ifc-classes``, in a group of their own."""
+    and ``--ifc-classes``, in a group of their own; the photos source's scale options in
+    another."""
     group = parser.add_argument_group("import options, with --mesh or --ifc "
                                       "(docs/importing.md)")
     defaults = ImportConfig()
@@ -77,6 +80,13 @@ def add_import_arguments(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--ifc-classes", type=Path, metavar="JSON",
                        help="with --ifc: your entity/GlobalId -> class mapping, e.g. "
                             '{"IfcCovering": "wall", "IfcRailing": "skip"}')
+    photos = parser.add_argument_group("photos options, with --photos: one scale is needed "
+                                       "(docs/importing.md, section 9)")
+    photos.add_argument("--known-distance", nargs=3, metavar=("PHOTO_A", "PHOTO_B", "METRES"),
+                        help="the distance in metres between the places two photos (file "
+                             "names) were taken from")
+    photos.add_argument("--known-height", type=float, metavar="METRES",
+                        help="the building's height in metres, ground to top")
 
 
 def chosen_source(args: argparse.Namespace, sources: Sequence[Source]) -> tuple[Source, str]:
@@ -111,6 +121,13 @@ def source_options(source: Source, args: argparse.Namespace, *, building_id: str
                                    ifc_classes=args.ifc_classes, progress=progress)
     if args.ifc_classes is not None:
         raise ValueError(f"--ifc-classes goes with --ifc, not with {source.flag}")
+    scale_given = args.known_distance is not None or args.known_height is not None
+    if source.options_type is PhotosOptions:
+        return PhotosOptions(photos_scale_from_args(args) if scale_given else None,
+                             progress=progress)
+    if scale_given:
+        raise ValueError(f"--known-distance and --known-height go with --photos, not with "
+                         f"{source.flag}")
     if source.options_type is NoOptions:
         return NoOptions()
     raise ValueError(f"source {source.name} reads {source.options_type.__name__}, which the "
@@ -128,6 +145,25 @@ def import_config_from_args(args: argparse.Namespace) -> ImportConfig:
     values = {f.name: getattr(args, f"import_{f.name}") for f in fields(ImportConfig)
               if f.name != "recentre"}
     return ImportConfig(recentre=not args.keep_position, **values)
+
+
+def photos_scale_from_args(args: argparse.Namespace) -> ScaleHint:
+    """The :class:`ScaleHint` of ``--known-distance`` / ``--known-height``.
+
+    Raises
+    ------
+    ValueError
+        A distance that is no number, none or both given, or a value out of range.
+    """
+    known = None
+    if args.known_distance is not None:
+        photo_a, photo_b, metres = args.known_distance
+        try:
+            known = KnownDistance(photo_a, photo_b, float(metres))
+        except ValueError:
+            raise ValueError(f"--known-distance PHOTO_A PHOTO_B METRES: {metres!r} is not a "
+                             "number of metres") from None
+    return ScaleHint(known, args.known_height)
 
 
 def _by_flag(sources: Sequence[Source]) -> dict[str, list[Source]]:

@@ -1,8 +1,8 @@
 """Every way a building or a scene enters the benchmark: :data:`SOURCES`, the one list.
 
 ``python -m dataset.generate`` offers one option per source flag (``--preset``, ``--mesh``,
-``--ifc``, ``--buildnet3d``, ``--citygml``) and ``--input PATH``, which takes the first
-source in this order that detects PATH. A new source (a reader of another format) is
+``--ifc``, ``--buildnet3d``, ``--citygml``, ``--photos``) and ``--input PATH``, which takes
+the first source in this order that detects PATH. A new source (a reader of another format) is
 declared beside its reader as a :class:`dataset.importers.source.Source` and added here; the
 command line then offers it (:mod:`dataset.source_args`). The procedural presets are declared
 here because :mod:`dataset.presets` sits above :mod:`dataset.importers` in the data flow.
@@ -17,6 +17,7 @@ from dataset.importers.buildnet3d.blenderproc import BLENDERPROC_SOURCE
 from dataset.importers.buildnet3d.buildnet3d import BUILDNET3D_SOURCE
 from dataset.importers.citygml.source import CITYGML_SOURCE
 from dataset.importers.mesh.building_file import IFC_SOURCE, MESH_SOURCE
+from dataset.importers.photos.source import PHOTOS_SOURCE
 from dataset.importers.source import BuildingEntry, NoOptions, Source
 
 
@@ -49,7 +50,8 @@ PRESET_SOURCE = Source(
     choices=preset_names,
 )
 SOURCES: tuple[Source, ...] = (PRESET_SOURCE, MESH_SOURCE, IFC_SOURCE, BLENDERPROC_SOURCE,
-                               BUILDNET3D_SOURCE, CITYGML_SOURCE)
+                               BUILDNET3D_SOURCE, CITYGML_SOURCE, PHOTOS_SOURCE)
 """Every source, in the order ``--input`` tries them (the BlenderProc layout before the
 Blender generator's: a folder of either is told apart by its ``meta_data.json``; CityGML
-last: its files are told apart by their root element, a folder by its first file)."""
+after them: its files are told apart by their root element, a folder by its first file;
+photos last: any folder holding a JPEG or PNG is one)."""

@@ -2,7 +2,7 @@
 
 Pixel (u, v) has column u and row v (v grows downward); its centre is at
 (u + 0.5, v + 0.5) in the same continuous image coordinates as cx, cy.
-Depth is z-depth along the optical axis in metres (DESIGN.md).
+Depth is z-depth along the optical axis in metres (docs/DESIGN.md).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Semantic class ids shared by every part of the project (DESIGN.md).
+"""Semantic class ids shared by every part of the project (docs/DESIGN.md).
 
 Ids 0-3 match the public BuildNet3D generator. The facade classes (wall, window,
 door) make up the gross facade area; roof and other never count as facade.

@@ -1,6 +1,6 @@
 """A triangle mesh whose faces carry a semantic class and a facade id, and its PLY file.
 
-The PLY is binary little-endian with per-face ``label`` (uchar, DESIGN.md class
+The PLY is binary little-endian with per-face ``label`` (uchar, docs/DESIGN.md class
 id) and ``facade`` (int, facade id from 1, or 0 for none) properties, which trimesh, MeshLab
 and Blender read. Writing is deterministic: equal meshes give identical bytes.
 """

@@ -66,7 +66,7 @@ class Method:
     ``"gpu"`` if it needs one. ``config_type``: a frozen dataclass whose default
     instance is the config it runs with (its fields go into the result's
     provenance). ``packages``: importable packages whose source its results
-    depend on, besides ``dataset`` (a change there recomputes its results);
+    depend on, besides ``envelope`` (a change there recomputes its results);
     ``libraries``: distributions whose versions matter. ``has_footprint``:
     whether it estimates a footprint (it is then listed in Table 3). ``paper_name``:
     its name in the BuildNet3D paper's Tables 2 and 3, whose published figures the
@@ -81,7 +81,8 @@ class Method:
     device must exist here).
 
     Optional, for methods that need more: ``record_config(config)``: the config
-    as its results record it (default: the dataclass's fields);
+    as its results record it (default: the dataclass's fields; the comparison writes it into
+    each result and keys the result's provenance on it);
     ``reserve(config)``: ``(cpus, gpus)`` one run reserves on a cluster node
     (default: 1 CPU, and 1 GPU if ``resources`` is ``"gpu"``); ``artefacts``: the
     folder under the results folder where it keeps one folder per scene (see

@@ -1,4 +1,4 @@
-"""The result file every method writes: one JSON per (scene, method, protocol) (DESIGN.md).
+"""The result file every method writes: one JSON per (scene, method, protocol) (docs/DESIGN.md).
 
 Methods (``baselines``, ``neural3d``) write these; ``metrics.compare`` reads
 only these and the scenes' ground truth.

@@ -1,4 +1,4 @@
-"""One building's scene in memory: its posed frames, classes, depth unit and truth (DESIGN.md).
+"""One building's scene in memory: its posed frames, classes, depth unit and truth (docs/DESIGN.md).
 
 Paths in a :class:`Frame` are relative to the scene folder, as in
 ``transforms.json`` (read and written by :mod:`envelope.scenes.scene`).

@@ -1,4 +1,4 @@
-"""Exact ground truth of one building: ``building.json`` (DESIGN.md).
+"""Exact ground truth of one building: ``building.json`` (docs/DESIGN.md).
 
 Areas follow one convention everywhere: a window's (or door's) area is its
 opening in the facade plane; the reveal (the shallow recess around it) is not
@@ -227,7 +227,7 @@ def read_building(path: str | Path) -> BuildingTruth:
     Raises
     ------
     ValueError
-        If the file is missing or lacks a field of DESIGN.md's schema.
+        If the file is missing or lacks a field of docs/DESIGN.md's schema.
     """
     path = Path(path)
     if not path.is_file():

@@ -1,4 +1,5 @@
-"""The one definition of the window-to-wall ratio (DESIGN.md), in the core every package imports.
+"""The one definition of the window-to-wall ratio (docs/DESIGN.md), in the core every package
+imports.
 
 WWR = window area / gross facade area, gross facade = wall + window + door.
 Areas in m² come in as one value, :class:`ClassAreas` (``.gross_m2``, ``.wwr``):

@@ -18,17 +18,17 @@ from dataset.benchmark_cache import DefaultBenchmark
 from envelope.atomic import write_json_atomic
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.results import code_version
+from envelope.scenes.scene import find_scene_folders
 from figures.dataset_table import read_truths, table1_dataset
 from figures.footprints import footprint_pairs, plot_footprint_overlays
 from figures.meshes import plot_reconstructed_meshes, reconstructed_meshes
 from figures.pipeline import plot_2dss_pipeline
 from figures.renders import plot_example_renders
 from figures.style import MissingInput
-from metrics.compare import FOOTPRINTS_FOLDER, PIPELINE_FOLDER, PROVENANCE_FILE
+from metrics.comparison import FOOTPRINTS_FOLDER, PIPELINE_FOLDER, PROVENANCE_FILE
 from metrics.report.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
 from metrics.report.report import PER_BUILDING_NAME, read_building_errors_csv
 from metrics.report.tables import write_table
-from metrics.run.runner import find_scenes
 from metrics.score.aggregate import aggregate_by_family
 
 FIGURES_PROVENANCE = "figures_provenance.json"
@@ -49,7 +49,7 @@ def make_figures(data: Path | None, results: Path, out: Path) -> dict[str, list[
     if data is not None and not data.is_dir():
         raise ValueError(f"data folder {data} does not exist")
     try:
-        truths = read_truths(find_scenes(data)) if data is not None else []
+        truths = read_truths(find_scene_folders(data)) if data is not None else []
     except ValueError:
         truths = []  # a folder without scenes: the figures of the comparison are still made
     comment = (f"produced by `python -m figures.make` (envelope-bench {code_version()}) "

@@ -21,17 +21,17 @@ from pathlib import Path
 import numpy as np
 
 from envelope.classes import SemanticClass
-from envelope.scenes.scene import read_scene
+from envelope.scenes.scene import find_scene_folders, read_scene
+from metrics.comparison import compare
 from metrics.report.tables import Table, write_table
 from metrics.run.predicted_masks import (
     TABLE_NAME,
-    CompareFn,
     PredictedRun,
     predicted_run,
     splits_read,
     with_predicted_masks,
 )
-from metrics.run.runner import MethodSpec, find_scenes
+from metrics.run.runner import MethodSpec
 from metrics.score.aggregate import summarise
 from metrics.score.errors import BuildingErrors
 from segment.evaluate import SceneIou, masks_scene_iou
@@ -40,20 +40,20 @@ from segment.segmenter import Segmenter
 
 def compare_on_predicted_masks(
     segmenter: Segmenter, data: Path, results: Path, out: Path,
-    specs_for: Callable[[Path], list[MethodSpec]], compare: CompareFn, *, command: str,
-    **options,
+    specs_for: Callable[[Path], list[MethodSpec]], *, command: str, **options,
 ) -> tuple[Table, PredictedRun]:
     """Compare on exact masks and on ``segmenter``'s; write the table :data:`TABLE_NAME`
     into the predicted run's ``out`` and return it with the run's folders (``options``
-    go to ``compare``; ``specs_for(results folder)`` makes the methods' specs)."""
+    go to :func:`metrics.comparison.compare`; ``specs_for(results folder)`` makes the
+    methods' specs)."""
     specs = specs_for(results)
     exact = compare(data, specs, results, out, command=command, **options)
     run = predicted_run(data, results, out, segmenter, splits_read(specs))
     predicted = compare(run.data, with_predicted_masks(specs_for(run.results), segmenter),
                         run.results, run.out, command=command, **options)
-    exact_dirs = {d.name: d for d in find_scenes(data)}
+    exact_dirs = {d.name: d for d in find_scene_folders(data)}
     ious = [masks_scene_iou(read_scene(exact_dirs[d.name]), read_scene(d))
-            for d in find_scenes(run.data) if d.name in exact_dirs]
+            for d in find_scene_folders(run.data) if d.name in exact_dirs]
     table = exact_vs_predicted_table(exact.rows, predicted.rows, ious, segmenter.name)
     write_table(table, run.out, f"produced by `{command}`")
     return table, run

@@ -17,10 +17,11 @@ from pathlib import Path
 
 from dataset.degrade.spec import DegradeSpec
 from envelope.atomic import write_text_atomic
+from metrics.comparison import compare
 from metrics.report.robustness_plot import RobustnessRow, plot_robustness
 from metrics.report.tables import Table, to_csv, to_markdown
 from metrics.run.degraded import degraded_run, with_degradation
-from metrics.run.runner import MethodSpec
+from metrics.run.runner import Execute, MethodSpec, execute_local
 from metrics.score.aggregate import method_rank, protocol_rank
 from metrics.score.errors import BuildingErrors
 
@@ -64,14 +65,13 @@ class RobustnessStudy:
 
 def run_study(
     data: Path, results: Path, out: Path, specs_for: SpecsFor, study: RobustnessStudy,
-    compare: Callable[..., object],
+    *, execute: Execute = execute_local,
 ) -> list[RobustnessRow]:
-    """Run the clean comparison and every (degradation, severity); write table and plot.
-
-    ``compare`` is :func:`metrics.compare.compare` (passed in: no upward import).
-    """
+    """Run the clean comparison and every (degradation, severity) with
+    :func:`metrics.comparison.compare`, their missing runs made with ``execute``; write
+    table and plot."""
     clean = compare(data, specs_for(results), results, out / "clean",
-                    command="python -m metrics.compare --robustness")
+                    command="python -m metrics.compare --robustness", execute=execute)
     rows: list[RobustnessRow] = []
     for name, _ in study.levels:
         rows += summarise(clean.rows, name, 0.0)
@@ -84,7 +84,7 @@ def run_study(
                 specs = [s for s in specs if not s.heavy]
             comparison = compare(run.data, with_degradation(specs, degradation), run.results,
                                  run.out, command=f"python -m metrics.compare --robustness "
-                                 f"({degradation[0].text})")
+                                 f"({degradation[0].text})", execute=execute)
             rows += summarise(comparison.rows, name, severity)
     table = robustness_table(rows)
     comment = "robustness study: mean APE (%) over buildings; severity 0 = clean inputs"
@@ -92,7 +92,6 @@ def run_study(
     write_text_atomic(out / "robustness.md", to_markdown(table, comment))
     plot_robustness(rows, out / "robustness")
     return rows
-
 
 
 def summarise(rows: Sequence[BuildingErrors], degradation: str,

@@ -6,8 +6,12 @@
   head, mapped to :mod:`envelope.classes` ids by the run's class names) and RGB
   from the colour network looking at the surface head-on (view direction =
   -vertex normal, so the colour does not depend on where a camera happened to be);
-- ``footprint.geojson``: zero contour of the SDF averaged over ``footprint_heights_m``,
-  its straight runs straightened (:mod:`neural3d.extraction.straight_walls`);
+- ``footprint.geojson``: the ground floor's outline, the zero contour of the SDF averaged
+  over ``footprint_heights_m``, its straight runs straightened
+  (:mod:`neural3d.extraction.straight_walls`); it is the result's ``footprint``;
+- ``footprint_widest.geojson``: the widest outline, the union of the sections from the
+  lowest footprint plane to the box top (:func:`widest_outline`), straightened alike: what
+  a roof plan draws (not in the result, which holds one footprint);
 - ``<scene>__neural3d__train.json``: the :class:`envelope.results.MethodResult`.
 
 Facades are the mesh's own facade groups (:mod:`neural3d.extraction.measure`), numbered
@@ -42,7 +46,7 @@ from neural3d.extraction.extract_config import (
     footprint_heights_m,
     without_stages,
 )
-from neural3d.extraction.footprint import footprint_from_sdf
+from neural3d.extraction.footprint import footprint_from_sdf, widest_outline_from_sdf
 from neural3d.extraction.measure import MeshMeasurement, measure_semantic_mesh
 from neural3d.extraction.meshing import (
     ColorFn,
@@ -53,8 +57,8 @@ from neural3d.extraction.meshing import (
     extract_mesh,
 )
 from neural3d.extraction.straight_walls import straighten_footprint
+from neural3d.method import METHOD_NEURAL3D
 
-METHOD = "neural3d"
 PROTOCOL = TRAIN_PROTOCOL
 
 
@@ -186,7 +190,7 @@ def measure_mesh(trained, mesh: SemanticMesh, config: ExtractConfig, *, device: 
         footprint = None
         warnings.append(f"no footprint: {exc}")
     return MethodResult(
-        scene=trained.scene_name, method=METHOD, protocol=PROTOCOL, wwr=m.wwr,
+        scene=trained.scene_name, method=METHOD_NEURAL3D.name, protocol=PROTOCOL, wwr=m.wwr,
         window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
         footprint=footprint, config=asdict(config), code_version=code_version(),
         facade_identity="geometry",
@@ -210,13 +214,24 @@ def extract_run(
     that evaluation step (its snapshot) instead of the checkpoint's. Everything
     is computed before anything is written, and each file is written atomically.
     """
-    from neural3d.field.trained import load_trained_field
-
     run_dir = Path(run_dir)
-    if not run_dir.is_dir():
-        raise ValueError(f"run folder {run_dir} does not exist")
     if out_dir is None:
         out_dir = run_dir / "extract" if step is None else run_dir / "extract" / f"step_{step}"
+    result = measure_run(run_dir, config=config, device=device, out_dir=Path(out_dir),
+                         progress=progress, step=step)
+    write_result(out_dir, result)
+    return result
+
+
+def measure_run(run_dir: Path, *, config: ExtractConfig, device: torch.device, out_dir: Path,
+                progress: bool = False, step: int | None = None) -> MethodResult:
+    """:func:`extract_run` without the result file: writes ``mesh.ply`` and
+    ``footprint.geojson`` into ``out_dir`` and returns the result (the comparison writes it
+    once, with its provenance, into its results folder)."""
+    from neural3d.field.trained import load_trained_field
+
+    if not Path(run_dir).is_dir():
+        raise ValueError(f"run folder {run_dir} does not exist")
     out_dir = Path(out_dir)
     try:
         trained = load_trained_field(run_dir, device=device, step=step)
@@ -225,15 +240,37 @@ def extract_run(
         raise ValueError(f"cannot load the run in {run_dir}: {first_line} (was it trained "
                          "with another version of neural3d?)") from exc
     result, mesh = measure_field(trained, config, device=device, progress=progress)
+    widest = widest_outline(trained, config, device=device)
     write_semantic_ply(out_dir / "mesh.ply", mesh.vertices_m, mesh.faces, mesh.vertex_labels,
                        mesh.vertex_rgb)
-    footprint_path = out_dir / "footprint.geojson"
-    if result.footprint is not None:
-        write_json_atomic(footprint_path, result.footprint)
-    else:  # a footprint from an earlier extraction would contradict this result
-        footprint_path.unlink(missing_ok=True)
-    write_result(out_dir, result)
+    for name, outline in (("footprint", result.footprint), ("footprint_widest", widest)):
+        path = out_dir / f"{name}.geojson"
+        if outline is not None:
+            write_json_atomic(path, outline)
+        else:  # an outline from an earlier extraction would contradict this one
+            path.unlink(missing_ok=True)
     return result
+
+
+def widest_outline(trained, config: ExtractConfig, *, device: torch.device
+                   ) -> dict | None:
+    """The field's widest outline as a GeoJSON Polygon (world x/y m)
+    (:func:`neural3d.extraction.footprint.widest_outline_from_sdf` from the lowest footprint
+    plane, ``footprint_widest_step_m`` apart, straightened as the footprint is); None where
+    no plane meets the building."""
+    try:
+        polygon = widest_outline_from_sdf(
+            field_sdf_fn(trained, device, config.chunk_points), trained.box_min_m,
+            trained.box_max_m, from_height_m=min(footprint_heights_m(trained.box_max_m, config)),
+            step_m=config.footprint_widest_step_m,
+            cell_m=footprint_cell_m(trained.box_min_m, trained.box_max_m, config),
+            min_area_m2=config.footprint_min_area_m2)
+    except ValueError:
+        return None
+    if config.straight_walls:
+        polygon = straighten_footprint(polygon, tolerance_m=config.footprint_wall_tolerance_m,
+                                       min_wall_m=config.footprint_min_wall_m)
+    return polygon_to_geojson(polygon)
 
 
 def facade_estimates(measurement: MeshMeasurement) -> tuple[FacadeEstimate, ...]:

@@ -26,7 +26,7 @@ from neural3d.config import TrainConfig, config_to_dict, preset_config
 from neural3d.extraction.extract_config import ExtractConfig
 
 RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
-EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson, result
+EXTRACT_FOLDER = "extract"  # in a run folder: mesh.ply, footprint.geojson
 LIBRARIES = ("numpy", "torch", "scipy", "scikit-image", "shapely", "trimesh", "pillow")
 
 
@@ -146,12 +146,9 @@ def record_config(budget: Neural3dBudget) -> dict[str, Any]:
     measurement), the training config (its ``iterations`` = the step budget) and a
     ``budget`` entry (preset, steps, safety cap, threads, device), so a result trained,
     meshed or measured otherwise is recomputed."""
-    return {**asdict(extract_config(budget)), **_budget_record(budget)}
-
-
-def _budget_record(budget: Neural3dBudget) -> dict[str, Any]:
     train = train_config(budget)
     return {
+        **asdict(extract_config(budget)),
         "budget": {"preset": budget.preset, "steps": train.iterations,
                    "max_seconds": budget.max_minutes * 60.0, "threads": budget.threads,
                    "device": budget.device},
@@ -161,8 +158,9 @@ def _budget_record(budget: Neural3dBudget) -> dict[str, Any]:
 
 def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
                  artefacts_dir: Path) -> MethodResult:
-    """Train for ``budget.steps`` steps (``neural3d.train``) into ``artefacts_dir / <scene>``,
-    then extract (``neural3d.extract``) into its ``extract`` folder.
+    """Train for ``budget.steps`` steps (``neural3d.train``, on ``scene`` as read here) into
+    ``artefacts_dir / <scene>``, then mesh and measure it (``neural3d.extract``) into its
+    ``extract`` folder; the result is returned, not written (the runner writes it).
 
     A run folder already there with the same training provenance
     (:func:`neural3d.training.run_folder.training_provenance`: training code, config,
@@ -171,12 +169,13 @@ def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
     stopped mid-building) is resumed. The result records the steps trained, whether the
     time cap cut training short, and, when training was reused, says so in ``warnings``
     with ``wall_time_s`` = the stored training and evaluation seconds + this extraction.
+    Its config is :func:`record_config`'s.
     """
     require_method_input(scene, "neural3d")
     import torch
 
     # isort sees a module as first-party only once its file exists: keep this block as is.
-    from neural3d.extract import extract_run  # noqa: I001
+    from neural3d.extract import measure_run  # noqa: I001
     from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
     from neural3d.train import train
     from neural3d.training.run_folder import prior_run, training_provenance
@@ -188,12 +187,12 @@ def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
     prior = prior_run(run_dir, training_provenance(scene.root, config, device),
                       config.iterations)
     if prior != "finished":
-        run_dir = train(scene.root, config, artefacts_dir, device=device,
+        run_dir = train(scene, config, artefacts_dir, device=device,
                         resume=prior == "partial", max_seconds=budget.max_minutes * 60.0)
     state = read_checkpoint(run_dir / CHECKPOINT_NAME, torch.device("cpu"))
     steps = int(state["step"])
     tic = time.perf_counter()
-    result = extract_run(run_dir, config=extract_config(budget), device=device,
+    result = measure_run(run_dir, config=extract_config(budget), device=device,
                          out_dir=run_dir / EXTRACT_FOLDER)
     reused = ()
     wall_time_s = 0.0  # the runner times the whole run
@@ -202,7 +201,7 @@ def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
         reused = (f"training reused: {run_dir} was trained earlier with the same training "
                   f"code, config and scene ({trained_s:.0f} s); only extraction ran",)
         wall_time_s = trained_s + time.perf_counter() - tic
-    return replace(result, config={**result.config, **_budget_record(budget)}, steps=steps,
+    return replace(result, config=record_config(budget), steps=steps,
                    cut_short=steps < config.iterations, wall_time_s=wall_time_s,
                    warnings=result.warnings + reused, seed=budget.seed)
 

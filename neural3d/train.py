@@ -24,6 +24,7 @@ from envelope.atomic import write_json_atomic
 from envelope.classes import CLASS_NAMES
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.device import resolve_device
+from envelope.method_input import MethodInput, require_method_input
 from envelope.progress import progress_bar
 from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from envelope.resources import check_training_resources
@@ -60,10 +61,14 @@ LOG_EVERY = 10  # steps between log.csv rows
 Callback = Callable[[int, TrainedField], "bool | None"]
 
 
-def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.device,
+def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: torch.device,
           resume: bool = False, max_seconds: float | None = None,
           callback: Callback | None = None) -> Path:
     """Train on the scene's ``train`` frames; returns the run folder ``out_dir/<scene name>``.
+
+    ``scene`` is the scene as a method reads it (no truth:
+    :func:`envelope.scenes.scene.read_method_input`), read once by the caller; its ``root``
+    names the run folder and is what the run's record and provenance point to.
 
     ``max_seconds`` stops after that much training time (a checkpoint is written);
     ``callback(step, field)`` runs every ``config.eval_every`` steps and stops
@@ -77,8 +82,8 @@ def train(scene_dir: Path, config: TrainConfig, out_dir: Path, *, device: torch.
         unavailable device, or ``resume`` without a checkpoint or with another config.
     """
     device = resolve_device(device)
-    scene_dir = Path(scene_dir)
-    scene = read_method_input(scene_dir)  # never the truth
+    scene = require_method_input(scene, "neural3d.train")
+    scene_dir = scene.root
     run_dir = Path(out_dir) / scene_name(scene_dir)
     bg = background_class(scene)
     check_training_resources(sum(
@@ -258,8 +263,9 @@ def main(argv: list[str] | None = None) -> int:
             raise ValueError(f"--max-minutes must be > 0, got {args.max_minutes}")
         check_output_folder(args.out)
         max_s = None if args.max_minutes is None else 60.0 * args.max_minutes
-        print(train(args.scene, config, args.out, device=args.device, resume=args.resume,
-                    max_seconds=max_s))
+        device = resolve_device(args.device)
+        print(train(read_method_input(args.scene), config, args.out, device=device,
+                    resume=args.resume, max_seconds=max_s))
         return 0
 
     def interrupted() -> str:

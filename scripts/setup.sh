@@ -30,6 +30,6 @@ if ! command -v chromium >/dev/null 2>&1; then
 fi
 # [cluster]: Ray (pinned), for `--executor ray` and its tests.
 "$PY" -m pip install --quiet --disable-pip-version-check -e ".[test,cluster]"
-"$PY" -c "import torch, trimesh, embreex, kornia, cv2, skimage, shapely, ray, ifcopenshell, plotly, playwright, cjio, lxml, pyproj, jsonschema, geomeppy, eppy" \
+"$PY" -c "import torch, trimesh, embreex, kornia, cv2, skimage, shapely, ray, ifcopenshell, plotly, playwright, cjio, pycolmap, lxml, pyproj, jsonschema, geomeppy, eppy" \
     || { echo "setup: a dependency failed to import; see the messages above" >&2; exit 1; }
 echo "setup: done ($("$PY" -c 'import torch; print("torch", torch.__version__, "CPU build" if torch.version.cuda is None else f"CUDA {torch.version.cuda} build")'))"

@@ -20,11 +20,10 @@ from tqdm import tqdm
 from envelope.atomic import write_text_atomic
 from envelope.classes import CLASS_NAMES, NUM_CLASSES, SemanticClass
 from envelope.cli_errors import add_debug_flag, exit_cli, run_cli
+from envelope.photo_io import read_photo_rgb
 from envelope.scene_record import Scene
-from envelope.scenes.scene import read_scene
+from envelope.scenes.scene import find_scene_folders, read_scene
 from envelope.scenes.scene_validation import read_frame_labels
-from segment.photo_io import read_photo_rgb
-from segment.scene_masks import scene_folders
 from segment.segmenter import Segmenter, resolve_segmenter, segment_rgb
 
 T = TypeVar("T")
@@ -159,10 +158,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.max_frames is not None and args.max_frames < 1:
             raise ValueError(f"--max-frames must be >= 1, got {args.max_frames}")
         segmenter = resolve_segmenter(args.model, threads=args.threads)
-        dirs = scene_folders(args.data)
-        if not dirs:
-            raise ValueError(f"--data {args.data} holds no scene folder (one with "
-                             f"transforms.json)")
+        dirs = find_scene_folders(args.data, with_images=True)
         rows = [segmenter_scene_iou(read_scene(d), segmenter, args.max_frames)
                 for d in tqdm(dirs, desc="segment", unit="building")]
         text = iou_table(rows)

@@ -8,7 +8,7 @@ reuses copies made by the same segmenter from the same scenes.
 
 ``--photos``: writes ``<out>/<stem>.png`` (class ids, one byte per pixel, of the upright
 photo) for every image file given or in the folder given. Each photo is read by
-:func:`segment.photo_io.read_photo_rgb` (EXIF orientation applied; grey, 16-bit, CMYK,
+:func:`envelope.photo_io.read_photo_rgb` (EXIF orientation applied; grey, 16-bit, CMYK,
 palette and alpha images converted); one that cannot be read (truncated, corrupt) is
 named with the reason on stderr and skipped, the others are segmented, and the exit
 status is 1.
@@ -25,7 +25,8 @@ from tqdm import tqdm
 
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.scenes.images import write_labels
-from segment.scene_masks import predicted_scene, scene_folders
+from envelope.scenes.scene import find_scene_folders
+from segment.scene_masks import predicted_scene
 from segment.segmenter import Segmenter, resolve_segmenter, segment_photo
 
 PHOTO_SUFFIXES = (".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp")
@@ -101,10 +102,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     def body() -> int:
         if args.photos is not None:
             return photos_body()
-        dirs = scene_folders(args.data)
-        if not dirs:
-            raise ValueError(f"--data {args.data} holds no scene folder (one with "
-                             f"transforms.json)")
+        dirs = find_scene_folders(args.data, with_images=True)
         check_output_folder(args.out)
         if args.out.resolve() in {d.resolve().parent for d in dirs}:
             raise ValueError(f"--out {args.out} holds the scenes themselves; choose another "

@@ -28,6 +28,7 @@ from tqdm import tqdm
 from dataset.degrade.scene_copy import link_tree
 from envelope.atomic import atomic_directory
 from envelope.classes import CLASS_NAMES
+from envelope.photo_io import read_photo_rgb
 from envelope.provenance import (
     Provenance,
     file_fingerprint,
@@ -37,24 +38,10 @@ from envelope.provenance import (
 from envelope.scene_record import Frame
 from envelope.scenes.images import write_labels
 from envelope.scenes.scene import read_scene, write_transforms
-from segment.photo_io import read_photo_rgb
 from segment.segmenter import Segmenter, segment_rgb
 
 RECORD_KEY = "predicted_masks"
 SEMANTICS_FOLDER = "semantics"
-
-
-def scene_folders(folder: str | Path) -> list[Path]:
-    """``folder`` if it is a scene folder (has ``transforms.json``), else its sub-folders
-    that are (not hidden ones: unfinished copies), sorted; ``[]`` if none or if
-    ``folder`` is no folder."""
-    folder = Path(folder)
-    if (folder / "transforms.json").is_file():
-        return [folder]
-    if not folder.is_dir():
-        return []
-    return sorted(d for d in folder.iterdir()
-                  if not d.name.startswith(".") and (d / "transforms.json").is_file())
 
 
 def masks_provenance(segmenter: Segmenter, source_dir: str | Path,

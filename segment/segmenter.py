@@ -25,9 +25,9 @@ import numpy as np
 import torch
 
 from envelope.classes import CLASS_NAMES, NUM_CLASSES
+from envelope.photo_io import read_photo_rgb
 from envelope.provenance import code_fingerprint, file_fingerprint, library_version
 from segment.network import UNet
-from segment.photo_io import read_photo_rgb
 from segment.weights import BUILT_IN_WEIGHTS, DEFAULT_WEIGHTS, load_network
 
 ENTRY_POINT_GROUP = "envelope_bench.segmenters"
@@ -184,7 +184,7 @@ def segment_rgb(segmenter: Segmenter, rgb: np.ndarray) -> np.ndarray:
 
 
 def segment_photo(segmenter: Segmenter, path: str | Path) -> np.ndarray:
-    """Read the photo at ``path`` (:func:`segment.photo_io.read_photo_rgb`: upright, 8-bit
+    """Read the photo at ``path`` (:func:`envelope.photo_io.read_photo_rgb`: upright, 8-bit
     RGB from grey, 16-bit, CMYK, palette or alpha images) and segment it: (H, W) uint8
     class ids of the upright image.
 

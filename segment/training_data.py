@@ -22,10 +22,9 @@ from envelope.classes import NUM_CLASSES
 from envelope.provenance import file_fingerprint
 from envelope.scene_record import Frame, Scene
 from envelope.scenes.images import read_rgb
-from envelope.scenes.scene import read_scene
+from envelope.scenes.scene import find_scene_folders, read_scene
 from envelope.scenes.scene_validation import read_frame_labels
 from segment.augment import IGNORE_LABEL, AugmentConfig, augment_frame
-from segment.scene_masks import scene_folders
 
 TRAINING_PRESET = "segtrain"
 EVALUATED_PRESETS: tuple[str, ...] = tuple(p for p in PRESETS if p != TRAINING_PRESET)
@@ -63,11 +62,11 @@ def load_training_scenes(folders: Sequence[Path]) -> list[TrainingScene]:
     """
     scenes = []
     for folder in folders:
-        dirs = scene_folders(folder)
-        if not dirs:
-            raise ValueError(f"{folder} holds no scene folder; render the training buildings "
-                             f"with `python -m dataset.generate --preset {TRAINING_PRESET} "
-                             f"--out {folder}`")
+        try:
+            dirs = find_scene_folders(folder, with_images=True)
+        except ValueError as exc:
+            raise ValueError(f"{exc} (the training buildings: `python -m dataset.generate "
+                             f"--preset {TRAINING_PRESET} --out {folder}`)") from exc
         scenes += [_training_scene(read_scene(d)) for d in dirs]
     return scenes
 

@@ -20,6 +20,7 @@ from shapely.geometry import Polygon, box
 
 from dataset.families.polygon_mesh import PlanarFace
 from envelope.classes import NO_FACADE, SemanticClass
+from envelope.polygons import polygon_area
 
 MIN_GAP_M = 0.05
 """Smallest distance between two openings, or an opening and the wall edge: holes must not
@@ -141,8 +142,7 @@ class WallSpec:
 
     def gross_area_m2(self) -> float:
         """Area of the outline (shoelace), openings and contacts included."""
-        u, v = self.outline_uv[:, 0], self.outline_uv[:, 1]
-        return 0.5 * abs(float(np.dot(u, np.roll(v, -1)) - np.dot(v, np.roll(u, -1))))
+        return polygon_area(self.outline_uv)
 
     def opening_area_m2(self, kind: OpeningKind) -> float:
         return float(sum(o.area_m2 for o in self.openings if o.kind == kind))

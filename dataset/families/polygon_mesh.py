@@ -19,6 +19,7 @@ from shapely.geometry import Polygon
 
 from envelope.classes import NO_FACADE, NUM_CLASSES
 from envelope.mesh import MERGE_DECIMALS, LabelledMesh
+from envelope.polygons import newell_vector
 
 COLLINEAR_TOL_M = 1e-7
 """A vertex closer than this to a triangle edge lies on it (earcut leaves such T-junctions and
@@ -239,7 +240,7 @@ def swept_faces(
     if ring.ndim != 2 or ring.shape[1] != 3 or len(ring) < 3 or length <= 0:
         raise ValueError("a sweep needs an (n >= 3, 3) ring and a non-zero (3,) offset")
     d = offset / length
-    newell = _cross_3d(ring, np.roll(ring, -1, axis=0)).sum(axis=0)
+    newell = newell_vector(ring)
     if abs(newell @ d) < (1 - 1e-9) * np.linalg.norm(newell):
         raise ValueError("the sweep offset must be perpendicular to the ring's plane")
     # Seen from +d, a counter-clockwise ring has its outside to the right of each edge.

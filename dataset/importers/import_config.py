@@ -21,7 +21,7 @@ class ImportConfig:
     """The file's up axis: glTF exported by Blender is y-up."""
     recentre: bool = True
     """Move the mesh so that its x/y bounding-box centre is at the origin and its ground at
-    z = 0 (DESIGN.md's world); the shift is recorded in the truth's ``extra``."""
+    z = 0 (docs/DESIGN.md's world); the shift is recorded in the truth's ``extra``."""
     ground_z_m: float | None = None
     """Ground level in the file's frame (after ``up_axis``): faces and face parts below it
     are underground, never facade; ``None``: the mesh's lowest point."""

@@ -5,7 +5,7 @@ hit gives the triangle. Embree works in float32, so the hit distance is then
 recomputed in float64 from the hit triangle's plane: depth is exact to float64
 rounding, not to Embree's float32 tolerance.
 
-The world's ground is the plane z = 0 (DESIGN.md): a surface hit below it is underground
+The world's ground is the plane z = 0 (docs/DESIGN.md): a surface hit below it is underground
 and the pixel shows the ground (an imported building's foundations are not seen).
 
 The RGB image (:func:`render_rgb`) shades the same hits; its look lives in

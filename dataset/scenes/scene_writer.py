@@ -1,4 +1,4 @@
-"""One building -> one complete scene folder (DESIGN.md layout), written atomically.
+"""One building -> one complete scene folder (docs/DESIGN.md layout), written atomically.
 
 The folder holds orbit views (Algorithm 1) split into train/eval, one ideal view
 per facade and five multi views per facade (and, with ``--street``, the street frames a car

@@ -1,4 +1,4 @@
-"""Reading and writing the per-frame image files of a scene (DESIGN.md formats).
+"""Reading and writing the per-frame image files of a scene (docs/DESIGN.md formats).
 
 | file | PNG format | in memory |
 |---|---|---|

@@ -1,8 +1,9 @@
 """A scene folder's ``transforms.json`` read into a :class:`~envelope.scene_record.Scene` and
-written back (DESIGN.md).
+written back (docs/DESIGN.md).
 
 Methods read scenes through :func:`read_method_input`, which never opens ``building.json``;
-:func:`read_scene` (the truth too) is for the dataset's tools and for metrics.
+:func:`read_scene` (the truth too) is for the dataset's tools and for metrics. Every command
+finds the scene folders it was given with :func:`find_scene_folders`.
 """
 
 from __future__ import annotations
@@ -22,6 +23,40 @@ from envelope.protocols import SPLITS, TRAIN_PROTOCOL
 from envelope.scene_record import DEFAULT_DEPTH_UNIT_M, Frame, Scene
 from envelope.scenes.scene_validation import validate_scene
 from envelope.truth import read_building
+
+
+def find_scene_folders(folder: str | Path, *, with_images: bool = False) -> list[Path]:
+    """The scene folders named by ``folder``: ``folder`` itself if it is one, else its
+    sub-folders that are (one level down), sorted by name.
+
+    A scene folder holds ``transforms.json`` (the images a method reads) or
+    ``building.json`` (the truth that metrics scores against); ``with_images``: only those
+    with ``transforms.json`` count (for a command that runs a method or a segmenter).
+    Hidden folders (``.<name>.partial``: a copy a killed run left unfinished, see
+    :func:`envelope.atomic.atomic_directory`) are no scenes.
+
+    Raises
+    ------
+    ValueError
+        If ``folder`` does not exist or holds no scene folder.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ValueError(f"data folder {folder} does not exist")
+    markers = ("transforms.json",) if with_images else ("transforms.json", "building.json")
+
+    def is_scene(d: Path) -> bool:
+        return any((d / m).is_file() for m in markers)
+
+    if is_scene(folder):
+        return [folder]
+    scenes = sorted(d for d in folder.iterdir()
+                    if d.is_dir() and not d.name.startswith(".") and is_scene(d))
+    if not scenes:
+        raise ValueError(
+            f"{folder} holds no scene folder (one with {' or '.join(markers)}) and is none; "
+            "make a benchmark with `python -m dataset.generate --preset tiny --out DIR`")
+    return scenes
 
 
 def read_scene(root: str | Path, *, validate: bool = True) -> Scene:

@@ -30,6 +30,7 @@ from envelope.orientation import (
     orientation_bin,
     true_north_xy_from_world,
 )
+from envelope.polygons import newell_normal
 from envelope.results import FacadeEstimate
 from envelope.truth import BuildingTruth, FacadeTruth
 from metrics.export.table import TRUTH_METHOD, North
@@ -163,10 +164,7 @@ def _plane_frame(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     origin = corners[0]
     u = corners[1] - corners[0]
     u /= np.linalg.norm(u)
-    normal = np.zeros(3)
-    for a, b in zip(corners, np.roll(corners, -1, axis=0)):  # Newell's normal
-        normal += np.cross(a, b)
-    normal /= np.linalg.norm(normal)
+    normal = newell_normal(corners)
     v = np.cross(normal, u)
     return origin, u, v
 

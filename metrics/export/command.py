@@ -19,12 +19,17 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from dataset.benchmark_cache import DefaultBenchmark, default_results_folder
+from dataset.benchmark_cache import (
+    DefaultBenchmark,
+    benchmark_of_results,
+    default_results_folder,
+)
 from envelope.atomic import atomic_directory, write_json_atomic, write_text_atomic
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.footprint import geojson_to_polygon
 from envelope.orientation import true_north_xy_from_world
 from envelope.results import MethodResult, code_version, read_result
+from envelope.scenes.scene import find_scene_folders
 from envelope.truth import BuildingTruth, read_building
 from metrics.export.cityjson import cityjson_building
 from metrics.export.formats import (
@@ -47,7 +52,6 @@ from metrics.export.table import (
     result_rows,
     truth_rows,
 )
-from metrics.run.runner import find_scenes
 from metrics.score.aggregate import method_rank, protocol_rank
 from metrics.score.facade_scoring import estimates_by_truth_facade
 
@@ -85,7 +89,7 @@ def read_inputs(results_dir: Path, data_dir: Path | None) -> ExportInputs:
         raise ValueError(f"{results_dir} holds no readable result file (<scene>__<method>__"
                          "<protocol>.json); run `python -m metrics.compare` first")
     truths = {}
-    for scene_dir in find_scenes(data_dir) if data_dir is not None else ():
+    for scene_dir in find_scene_folders(data_dir) if data_dir is not None else ():
         if (scene_dir / "building.json").is_file():
             try:
                 truth = read_building(scene_dir / "building.json")
@@ -231,10 +235,10 @@ def _paths(args: argparse.Namespace) -> tuple[Path, Path | None, Path]:
     if results is None:
         folder = DefaultBenchmark().folder
         results, data = default_results_folder(folder), data or folder
-    if data is None and results.name.endswith("-results"):
-        guess = results.with_name(results.name.removesuffix("-results"))
-        data = guess if guess.is_dir() else None
-    stem = results.name.removesuffix("-results")
+    guess = benchmark_of_results(results)
+    if data is None and guess is not None and guess.is_dir():
+        data = guess
+    stem = results.name if guess is None else guess.name
     out = args.out or results.with_name(f"{stem}-export")
     return results, data, out
 

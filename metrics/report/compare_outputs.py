@@ -13,13 +13,15 @@ from pathlib import Path
 from envelope.atomic import atomic_directory, write_json_atomic
 from metrics.report.html_report import write_report
 from metrics.report.plots import plot_errors_by_family, plot_iou_per_building, plot_wwr_scatter
+from metrics.report.report_data import ReportData
 from metrics.run.runner import MethodSpec, Outcome
 
 
-def write_html_report(out_dir: Path) -> None:
-    """``report.html`` from what was just written; a failure warns, the comparison stands."""
+def write_html_report(data: ReportData) -> None:
+    """``report.html`` of a comparison, in its output folder; a failure warns, the comparison
+    stands."""
     try:
-        write_report(out_dir)
+        write_report(data)
     except Exception as exc:  # the page is a view of the outputs, not one of them
         print(f"warning: report.html not written: {type(exc).__name__}: {exc}", file=sys.stderr)
 

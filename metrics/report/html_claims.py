@@ -1,48 +1,48 @@
-"""HTML sections of the report for the claims' qualifiers: errors against the visible facade
-truth and the seed-to-seed spread, each read from the CSV :mod:`metrics.compare` wrote."""
+"""The report's sections for the claims' qualifiers: errors against the visible facade
+truth and the seed-to-seed spread, each where the comparison made its table."""
 
 from __future__ import annotations
 
-from pathlib import Path
+from collections.abc import Mapping, Sequence
 
-from metrics.report.html_sections import Cell, esc, sortable_table
+from markupsafe import Markup
+
+from metrics.report.html_sections import Cell, label_cell, summary_cell
+from metrics.report.report_data import Record
 from metrics.report.report_seeds import SEED_TABLE_NAME
 from metrics.report.report_visible import TABLE2_VISIBLE_NAME, VISIBLE_NOTE
-from metrics.report.tables import format_cell, read_csv_rows, read_summary
+from metrics.report.templating import render
+from metrics.score.aggregate import Summary
 
 LABEL_KEYS = ("family", "method", "protocol", "buildings", "seeds")
+SECTIONS = (
+    (TABLE2_VISIBLE_NAME, "Table 2 against the full and the visible facade", 2, VISIBLE_NOTE),
+    (SEED_TABLE_NAME, "Seed-to-seed spread of repeated trainings", 3,
+     "std over one building's seeds (ddof=1), mean ± std over buildings"),
+)
 
 
-def claims_sections(out_dir: Path) -> str:
-    """The visible-truth Table 2 and the seed spread, each where its CSV exists."""
-    parts = []
-    for name, heading, decimals, note in (
-        (TABLE2_VISIBLE_NAME, "Table 2 against the full and the visible facade", 2,
-         VISIBLE_NOTE),
-        (SEED_TABLE_NAME, "Seed-to-seed spread of repeated trainings", 3,
-         "std over one building's seeds (ddof=1), mean ± std over buildings"),
-    ):
-        path = out_dir / f"{name}.csv"
-        if path.is_file():
-            parts.append(f"<h2>{esc(heading)}</h2>"
-                         f"{csv_table_html(name, read_csv_rows(path.read_text()), decimals)}"
-                         f'<p class="ref">{esc(note)}</p>')
-    return "".join(parts)
+def claims_sections(tables: Mapping[str, Sequence[Record]]) -> Markup:
+    """The visible-truth Table 2 and the seed spread, each where ``tables`` (records by table
+    name) holds it."""
+    sections = []
+    for name, heading, decimals, note in SECTIONS:
+        if name in tables:
+            columns, rows = records_table(tables[name], decimals)
+            sections.append({"heading": heading, "table_id": name, "columns": columns,
+                             "rows": rows, "note": note})
+    return render("claims.html.j2", sections=sections)
 
 
-def csv_table_html(table_id: str, rows: list[dict[str, str]], decimals: int) -> str:
-    """A sortable table of a CSV written by :func:`metrics.report.tables.to_csv`: label columns as
-    they are, each summary column (``<key>_mean`` ...) as ``mean ± std [low, high]``."""
-    if not rows:
-        return '<p class="muted">no rows</p>'
-    keys = list(rows[0])
+def records_table(records: Sequence[Record],
+                  decimals: int) -> tuple[list[str], list[list[Cell]]]:
+    """Columns and cells of a sortable table of ``records``: the label columns as they are,
+    each summary column as ``mean ± std [low, high]``."""
+    if not records:
+        return [], []
+    keys = list(records[0])
     labels = [k for k in keys if k in LABEL_KEYS]
-    summaries = [k[: -len("_mean")] for k in keys if k.endswith("_mean")]
-    cells: list[list[Cell]] = []
-    for r in rows:
-        row: list[Cell] = [(r[k] or "–", r[k]) for k in labels]
-        for key in summaries:
-            s = read_summary(r, key)
-            row.append((format_cell(s, decimals), "" if s.mean is None else repr(s.mean)))
-        cells.append(row)
-    return sortable_table(table_id, labels + summaries, cells)
+    summaries = [k for k in keys if any(isinstance(r.get(k), Summary) for r in records)]
+    cells = [[label_cell(r[k]) for k in labels] + [summary_cell(r[k], decimals)
+                                                   for k in summaries] for r in records]
+    return labels + summaries, cells

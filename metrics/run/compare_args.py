@@ -91,9 +91,10 @@ def parse_compare_args(argv: Sequence[str] | None,
     mode.add_argument(
         "--masks", metavar="predicted[:MODEL]",
         help="compare on a segmenter's masks instead of the exact ones (truth unchanged): "
-        "'predicted' uses the committed segmenter (segment/weights/default.pt), "
-        "'predicted:FILE.pt' other weights, 'predicted:NAME' an installed plugin "
-        "(entry point group envelope_bench.segmenters). The exact-mask comparison runs too; "
+        "'predicted' uses the default committed weights, 'predicted:NAME' other committed "
+        "weights by name (segment.weights.BUILT_IN_WEIGHTS), 'predicted:FILE.pt' other "
+        "weights, 'predicted:NAME' also an installed plugin (entry point group "
+        "envelope_bench.segmenters). The exact-mask comparison runs too; "
         "masks are cached in <data>-masks/, results go to <results>/masks/, outputs to "
         "<out>-masks-<key> with the table exact_vs_predicted. See docs/segment.md")
     parser.add_argument("--masks-threads", type=int, default=2,

@@ -18,7 +18,8 @@ from tqdm import tqdm
 
 from dataset.degrade.scene_copy import degrade_scene
 from dataset.degrade.spec import DegradeSpec, specs_key
-from metrics.run.runner import MethodSpec, find_scenes
+from envelope.scenes.scene import find_scene_folders
+from metrics.run.runner import MethodSpec
 
 CONFIG_KEY = "degradation"
 
@@ -37,7 +38,7 @@ def degraded_run(data: Path, results: Path, out: Path,
     """Degrade every scene of ``data`` (reusing finished copies) and name the folders."""
     key = specs_key(specs)
     cache = data.with_name(f"{data.name}-degraded") / key
-    scenes = [d for d in find_scenes(data) if (d / "transforms.json").is_file()]
+    scenes = find_scene_folders(data, with_images=True)
     for scene_dir in tqdm(scenes, desc=f"degrade {key}", unit="scene", leave=False):
         degrade_scene(scene_dir, cache, specs)
     return DegradedRun(cache, results / "degraded" / key, out.with_name(f"{out.name}-{key}"))
@@ -45,13 +46,6 @@ def degraded_run(data: Path, results: Path, out: Path,
 
 def with_degradation(specs: Sequence[MethodSpec],
                      degradation: tuple[DegradeSpec, ...]) -> list[MethodSpec]:
-    """The same methods, their requested and written configs carrying the specs."""
+    """The same methods, the configs their results record carrying the specs."""
     record = [s.to_json() for s in degradation]
-
-    def wrap(run):
-        def degraded(scene_dir: Path, protocol: str):
-            result = run(scene_dir, protocol)
-            return replace(result, config={**result.config, CONFIG_KEY: record})
-        return degraded
-
-    return [replace(s, config={**s.config, CONFIG_KEY: record}, run=wrap(s.run)) for s in specs]
+    return [replace(s, conditions={**s.conditions, CONFIG_KEY: record}) for s in specs]

@@ -13,17 +13,14 @@ the import error as the reason, and the other methods go on.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import fields, is_dataclass, replace
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-from envelope.executors.ray_tasks import TaskResources
 from envelope.method import BUILT_IN, Method, built_in_method, installed_methods
 from envelope.protocols import SELECTABLE_PROTOCOLS
-from envelope.results import MethodResult
-from envelope.scenes.scene import read_method_input
-from metrics.run.runner import MethodSpec
+from metrics.run.runner import MethodSpec, config_seed, folder_spec, run_on_folder
 
 METHODS: tuple[str, ...] = tuple(BUILT_IN)
 
@@ -56,16 +53,12 @@ def method_specs(
             continue
         config = configs.get(name)
         config = method.config_type() if config is None else config
-        if _has_seed(config):
+        if config_seed(config) is not None:
             specs += [spec_from_method(method, views, results_dir, replace(config, seed=s))
                       for s in seeds]
         else:
             specs.append(spec_from_method(method, views, results_dir, config))
     return specs
-
-
-def _has_seed(config: Any) -> bool:
-    return is_dataclass(config) and any(f.name == "seed" for f in fields(config))
 
 
 def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
@@ -78,35 +71,14 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
     """
     config = method.config_type() if config is None else config
     protocols = tuple(p for p in method.protocols if p not in SELECTABLE_PROTOCOLS or p in views)
-    seed = config.seed if _has_seed(config) else None
+    seed = config_seed(config)
     artefacts_dir = results_dir / method.artefacts if method.artefacts else None
     if artefacts_dir is not None and seed:
         artefacts_dir = artefacts_dir / f"seed{seed}"
-    run = partial(_run_on_folder, method, config)
+    run = partial(run_on_folder, method, config)
     if artefacts_dir is not None:
         run = partial(run, artefacts_dir=artefacts_dir)
-    cpus, gpus = method.cpus_gpus(config)
-    debug_images = None if method.debug_images is None else partial(
-        _debug_images_of_folder, method, config)
-    return MethodSpec(method.name, protocols, method.config_record(config), run,
-                      has_footprint=method.has_footprint,
-                      resources=TaskResources(cpus=cpus, gpus=gpus),
-                      artefacts_dir=artefacts_dir, code=("envelope", *method.packages),
-                      libraries=method.libraries, mesh_file=method.mesh_file,
-                      heavy=method.heavy, debug_images=debug_images, seed=seed,
-                      paper_name=method.paper_name)
-
-
-def _run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
-                   **artefacts_dir: Path) -> MethodResult:
-    return method.run(read_method_input(scene_dir, method.inputs), protocol, config,
-                      **artefacts_dir)
-
-
-def _debug_images_of_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
-                            folder: Path) -> None:
-    assert method.debug_images is not None
-    method.debug_images(read_method_input(scene_dir, method.inputs), protocol, config, folder)
+    return MethodSpec(method, config, protocols, run, artefacts_dir=artefacts_dir)
 
 
 def list_methods() -> list[str]:
@@ -151,4 +123,4 @@ def _unavailable(name: str, protocols: tuple[str, ...], exc: ImportError) -> Met
         raise RuntimeError(reason)
 
     # An empty config matches any stored result, so earlier results are still used.
-    return MethodSpec(name, protocols, {}, run)
+    return folder_spec(name, protocols, {}, run)

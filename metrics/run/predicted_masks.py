@@ -17,25 +17,21 @@ on exact and on predicted masks, and per family the means.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from functools import partial
 from pathlib import Path
-from typing import Any
 
 from tqdm import tqdm
 
 from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
-from metrics.run.runner import MethodSpec, find_scenes
+from envelope.scenes.scene import find_scene_folders
+from metrics.run.runner import MethodSpec
 from segment.scene_masks import predicted_scene
 from segment.segmenter import DEFAULT_NAME, Segmenter, resolve_segmenter
 
 CONFIG_KEY = "masks"
 PREDICTED = "predicted"
 TABLE_NAME = "exact_vs_predicted"
-CompareFn = Callable[..., Any]
-"""``metrics.compare.compare``: ``(data, specs, results, out, **options) -> Comparison``
-(passed in: ``metrics.compare`` imports this module, not the other way round)."""
 
 
 @dataclass(frozen=True)
@@ -115,7 +111,7 @@ def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter,
     """
     key = masks_key(segmenter)
     cache = data.with_name(f"{data.name}-masks") / key
-    scenes = [d for d in find_scenes(data) if (d / "transforms.json").is_file()]
+    scenes = find_scene_folders(data, with_images=True)
     for scene_dir in tqdm(scenes, desc=f"masks {key}", unit="scene", leave=False):
         predicted_scene(scene_dir, cache, segmenter, splits=splits)
     return PredictedRun(cache, results / "masks" / key, out.with_name(f"{out.name}-masks-{key}"),
@@ -123,14 +119,6 @@ def predicted_run(data: Path, results: Path, out: Path, segmenter: Segmenter,
 
 
 def with_predicted_masks(specs: Sequence[MethodSpec], segmenter: Segmenter) -> list[MethodSpec]:
-    """The same methods, their requested and written configs naming the segmenter (each
-    run stays picklable, so a method still runs in a process of its own or on Ray)."""
+    """The same methods, the configs their results record naming the segmenter."""
     record = {"segmenter": segmenter.name, **segmenter.identity}
-    return [replace(s, config={**s.config, CONFIG_KEY: record},
-                    run=partial(_run_on_masks, s.run, record)) for s in specs]
-
-
-def _run_on_masks(run: Callable, record: dict[str, Any], scene_dir: Path, protocol: str, **kwargs):
-    """``run``'s result with the segmenter ``record`` in its config."""
-    result = run(scene_dir, protocol, **kwargs)
-    return replace(result, config={**result.config, CONFIG_KEY: record})
+    return [replace(s, conditions={**s.conditions, CONFIG_KEY: record}) for s in specs]

@@ -8,8 +8,9 @@ one the current code would write (:func:`expected_provenance`); otherwise the
 log says which part changed and the method runs again, unless ``reuse_stale``
 keeps it on purpose (its outcome is then ``"stale"`` and the tables mark it).
 Results are written with :func:`envelope.results.write_result`, carrying the
-record. A method that raises is recorded as a failed outcome with its reason;
-the other runs go on.
+record, and the config and seed of their :class:`MethodSpec` (what the method itself put
+there is replaced: the spec is the one record of how it ran). A method that raises is
+recorded as a failed outcome with its reason; the other runs go on.
 
 The runs that are missing go to an executor (:data:`Execute`): here, one
 after the other in this process (:func:`execute_local`); on a Ray cluster
@@ -21,14 +22,17 @@ from __future__ import annotations
 
 import time
 import traceback
-from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field, fields, is_dataclass, replace
+from functools import partial
 from pathlib import Path
 from typing import Any, Literal
 
 from tqdm import tqdm
 
 from envelope.executors.ray_tasks import TaskResources
+from envelope.method import Method
+from envelope.method_input import MethodInput
 from envelope.provenance import (
     Provenance,
     file_fingerprint,
@@ -36,6 +40,7 @@ from envelope.provenance import (
     provenance_changes,
 )
 from envelope.results import MethodResult, read_result, result_filename, write_result
+from envelope.scenes.scene import read_method_input
 
 RunFn = Callable[[Path, str], MethodResult]
 """(scene folder, protocol) -> the method's result for that scene; may raise."""
@@ -45,41 +50,123 @@ OutcomeStatus = Literal["reused", "stale", "ran", "failed"]
 
 @dataclass(frozen=True)
 class MethodSpec:
-    """A method as the comparison runs it.
+    """A method as the comparison runs it: its :class:`envelope.method.Method` bound to a config.
 
-    ``config`` is the config the method will run with, as it appears in its
-    result JSON; ``has_footprint`` says whether it estimates a footprint;
-    ``resources`` what one run reserves on a cluster node. ``artefacts_dir``:
-    where ``run`` writes a folder per scene (named by the scene) that the
+    ``method``: what the method declares (its name, protocols, resources, code, ...);
+    ``method_config``: the config it runs with (an instance of ``method.config_type``);
+    ``protocols``: those it runs on in this comparison; ``run(scene folder, protocol)``: the
+    method bound to its config, reading the folder as its
+    :class:`~envelope.method_input.MethodInput` (:func:`metrics.run.methods.spec_from_method`).
+    ``artefacts_dir``: where ``run`` writes a folder per scene (named by the scene) that the
     comparison keeps (a trained method's run folder); such a ``run`` also takes an
     ``artefacts_dir=`` keyword to write it elsewhere (a worker on another machine).
-    ``mesh_file``: a semantic mesh inside a scene's artefacts folder, for the
-    figures and the report; ``heavy``: run only at the highest severity of a
-    robustness study (unless asked otherwise); ``debug_images(scene folder,
-    protocol, folder)``: write its pipeline images. All of these come from the
-    method's :class:`envelope.method.Method` (``metrics.run.methods``).
-    ``code`` names the modules or packages whose source the results depend on and
-    ``libraries`` the distributions whose versions they depend on: both go into
-    each result's provenance record, so changing them recomputes the results.
-    ``seed``: the training seed of a method whose config has one (neural3d); specs
-    that differ only by it keep their results side by side (``__seed<k>`` files).
-    ``paper_name``: the method's name in the BuildNet3D paper's tables, if it has one.
+    ``conditions``: what the comparison changed about the method's inputs (degraded images,
+    predicted masks), recorded in :attr:`config` beside the method's own config.
+
+    The rest is read off the method and its config (properties): :attr:`config`, the config
+    as every result of this spec records it and as its provenance keys it; :attr:`seed`, the
+    config's training seed (specs that differ only by it keep their results side by side,
+    ``__seed<k>`` files); :attr:`code` and :attr:`libraries`, what goes into each result's
+    provenance; :attr:`resources`, what one run reserves; and the method's name,
+    ``has_footprint``, ``paper_name``, ``heavy``, ``mesh_file`` and ``debug_images``.
+    A method given as a function of a scene folder gets its spec from :func:`folder_spec`.
     """
 
-    name: str
+    method: Method
+    method_config: Any
     protocols: tuple[str, ...]
-    config: dict[str, Any]
     run: RunFn
-    has_footprint: bool = False
-    resources: TaskResources = TaskResources()
     artefacts_dir: Path | None = None
-    code: tuple[str, ...] = ("envelope",)
-    libraries: tuple[str, ...] = ("numpy",)
-    mesh_file: str | None = None
-    heavy: bool = False
-    debug_images: Callable[[Path, str, Path], None] | None = None
-    seed: int | None = None
-    paper_name: str | None = None
+    conditions: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        return self.method.name
+
+    @property
+    def config(self) -> dict[str, Any]:
+        """The config as its results record it: the method's record of its config
+        (:meth:`envelope.method.Method.config_record`), then the :attr:`conditions`."""
+        return {**self.method.config_record(self.method_config), **self.conditions}
+
+    @property
+    def seed(self) -> int | None:
+        return config_seed(self.method_config)
+
+    @property
+    def code(self) -> tuple[str, ...]:
+        """The packages whose source the results depend on: the core and the method's own."""
+        return ("envelope", *self.method.packages)
+
+    @property
+    def libraries(self) -> tuple[str, ...]:
+        return self.method.libraries
+
+    @property
+    def resources(self) -> TaskResources:
+        cpus, gpus = self.method.cpus_gpus(self.method_config)
+        return TaskResources(cpus=cpus, gpus=gpus)
+
+    @property
+    def has_footprint(self) -> bool:
+        return self.method.has_footprint
+
+    @property
+    def paper_name(self) -> str | None:
+        return self.method.paper_name
+
+    @property
+    def heavy(self) -> bool:
+        return self.method.heavy
+
+    @property
+    def mesh_file(self) -> str | None:
+        return self.method.mesh_file
+
+    @property
+    def debug_images(self) -> Callable[[Path, str, Path], None] | None:
+        """``(scene folder, protocol, folder)``: write the method's pipeline images of the
+        scene into ``folder``; ``None`` if the method has none."""
+        if self.method.debug_images is None:
+            return None
+        return partial(_debug_images_of_folder, self.method, self.method_config)
+
+
+def config_seed(config: Any) -> int | None:
+    """The ``seed`` field of a dataclass config (neural3d's training seed), else ``None``."""
+    if is_dataclass(config) and any(f.name == "seed" for f in fields(config)):
+        return config.seed
+    return None
+
+
+def run_on_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
+                  **artefacts_dir: Path) -> MethodResult:
+    """``method`` run with ``config`` on the scene folder read as its
+    :class:`~envelope.method_input.MethodInput` (the inputs it declares, never the truth)."""
+    return method.run(read_method_input(scene_dir, method.inputs), protocol, config,
+                      **artefacts_dir)
+
+
+def _debug_images_of_folder(method: Method, config: Any, scene_dir: Path, protocol: str,
+                            folder: Path) -> None:
+    assert method.debug_images is not None
+    method.debug_images(read_method_input(scene_dir, method.inputs), protocol, config, folder)
+
+
+def folder_spec(name: str, protocols: Sequence[str], config: Any, run: RunFn, *,
+                packages: tuple[str, ...] = ()) -> MethodSpec:
+    """The spec of a method given as ``run(scene folder, protocol)`` (a test's or a
+    benchmark script's stand-in): its :class:`~envelope.method.Method` declares ``protocols``,
+    a config of ``config``'s type (a dict is recorded as it is) and ``packages`` as its code,
+    and reads the folder it is given."""
+    method = Method(name=name, inputs=(), protocols=tuple(protocols),  # type: ignore[arg-type]
+                    config_type=type(config), run=partial(_on_root, run), packages=packages)
+    return MethodSpec(method, config, tuple(protocols), run)
+
+
+def _on_root(run: RunFn, scene: MethodInput, protocol: str, config: Any,
+             **artefacts_dir: Path) -> MethodResult:
+    return run(scene.root, protocol, **artefacts_dir)
 
 
 @dataclass(frozen=True)
@@ -115,29 +202,6 @@ def execute_local(jobs: Sequence[Job], run_one: RunOne) -> Iterator[tuple[int, O
     """Run the jobs one after the other in this process."""
     for i, job in enumerate(jobs):
         yield i, run_one(job)
-
-
-def find_scenes(data: str | Path) -> list[Path]:
-    """Scene folders in ``data``: ``data`` itself if it is one, else its sub-folders that are.
-
-    A scene folder holds ``transforms.json`` (images to run methods on) or
-    ``building.json`` (ground truth); hidden folders (``.<name>.partial``: a copy a killed
-    run left unfinished, see :func:`envelope.atomic.atomic_directory`) are not scenes.
-    Raises ``ValueError`` when there is none.
-    """
-    data = Path(data)
-    if not data.is_dir():
-        raise ValueError(f"data folder {data} does not exist")
-    if _is_scene(data):
-        return [data]
-    scenes = sorted(p for p in data.iterdir()
-                    if p.is_dir() and not p.name.startswith(".") and _is_scene(p))
-    if not scenes:
-        raise ValueError(
-            f"{data} holds no scene folder (one with transforms.json or building.json); "
-            "make a benchmark with `python -m dataset.generate --preset tiny --out DIR`"
-        )
-    return scenes
 
 
 def expected_provenance(scene_dir: Path, spec: MethodSpec) -> Provenance:
@@ -187,7 +251,7 @@ def run_missing(
                 raise RuntimeError(f"the executor returned run {k} twice")
             if outcome.result is not None:
                 job = jobs[todo[k]]
-                result = replace(outcome.result, seed=job.spec.seed,
+                result = replace(outcome.result, config=job.spec.config, seed=job.spec.seed,
                                  provenance=records[job.scene_dir, job.spec.name, job.spec.seed])
                 outcome = replace(outcome, result=result, path=write_result(results_dir, result))
             else:
@@ -215,8 +279,8 @@ def run_job(job: Job) -> Outcome:
     except Exception as exc:  # one failing method must not stop the comparison
         reason = f"{type(exc).__name__}: {exc}{_where(exc)}".strip()
         return Outcome(scene, spec.name, protocol, "failed", reason=reason)
-    if result.scene != scene:
-        result = replace(result, scene=scene)
+    if (result.scene, result.method) != (scene, spec.name):  # they name the result file
+        result = replace(result, scene=scene, method=spec.name)
     if not result.wall_time_s:
         result = replace(result, wall_time_s=time.perf_counter() - start)
     return Outcome(scene, spec.name, protocol, "ran", result)
@@ -260,6 +324,3 @@ def _where(exc: BaseException) -> str:
         return ""
     return f" (at {Path(frames[-1].filename).resolve().relative_to(root)}:{frames[-1].lineno})"
 
-
-def _is_scene(folder: Path) -> bool:
-    return (folder / "transforms.json").is_file() or (folder / "building.json").is_file()

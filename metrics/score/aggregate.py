@@ -200,7 +200,7 @@ def _marks_text(marks: Sequence[str]) -> str:
 
 
 def family_rank(family: str) -> tuple[int, str]:
-    """Sort key: the benchmark's families in DESIGN.md order, others by name, ``all`` last."""
+    """Sort key: the benchmark's families in docs/DESIGN.md order, others by name, ``all`` last."""
     if family == ALL_FAMILIES:
         return (len(BUILDING_TYPES) + 1, family)
     if family in BUILDING_TYPES:

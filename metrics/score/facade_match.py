@@ -39,6 +39,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from shapely.geometry import Point, Polygon
 
+from envelope.polygons import newell_normal
 from envelope.results import FacadeEstimate
 from envelope.truth import BuildingTruth
 from envelope.wwr import ClassAreas
@@ -206,24 +207,3 @@ def _merge(parts: list[FacadeEstimate], facade_id: int) -> FacadeEstimate:
         centre_m=tuple(float(c) for c in np.average([p.centre_m for p in parts], axis=0,
                                                      weights=weight)),
     )
-
-
-def newell_normal(corners: np.ndarray) -> np.ndarray:
-    """Unit normal of a planar polygon, (n, 3) corners, by Newell's method (counter-clockwise
-    corners seen from the side it points to).
-
-    Raises
-    ------
-    ValueError
-        If the corners are on one line (no area).
-    """
-    nxt = np.roll(corners, -1, axis=0)
-    n = np.array([
-        np.sum((corners[:, 1] - nxt[:, 1]) * (corners[:, 2] + nxt[:, 2])),
-        np.sum((corners[:, 2] - nxt[:, 2]) * (corners[:, 0] + nxt[:, 0])),
-        np.sum((corners[:, 0] - nxt[:, 0]) * (corners[:, 1] + nxt[:, 1])),
-    ])
-    length = float(np.linalg.norm(n))
-    if length == 0:
-        raise ValueError("an outline has no area (its corners are on one line)")
-    return n / length

@@ -13,8 +13,13 @@ Facades are found from the horizontal direction of the facade triangles' normals
    neighbours within ``min_facade_separation_deg``;
 3. every triangle joins its nearest peak; within a peak, triangles are split
    into parallel planes where their offsets along the peak normal leave a gap
-   larger than ``plane_gap_m`` (the two parallel walls of an L-shape);
-4. groups smaller than ``min_facade_area_m2`` or ``min_facade_area_fraction`` of
+   larger than ``plane_gap_m`` (the two parallel walls of an L-shape, a bay's
+   front and the wall beside it, a set-back front);
+4. within a plane, triangles are split where their positions along the plane
+   (horizontal, the centroids' tangent coordinate) leave a gap larger than
+   ``plane_extent_gap_m``: two facades of one plane that stand apart (the
+   wall left and right of a bay, the fronts of two bays) are facades of their own;
+5. groups smaller than ``min_facade_area_m2`` or ``min_facade_area_fraction`` of
    the grouped area (window-reveal strips, noise) are dropped.
 
 A curved facade has no peaks of its own, so it is cut into segments about
@@ -86,16 +91,35 @@ def group_faces(vertices_m: np.ndarray, faces: np.ndarray, facade_area_m2: np.nd
         members = idx[nearest == k]
         mean_az = circular_mean_deg(azimuth[nearest == k], facade_area_m2[members])
         u = np.array([np.cos(np.radians(mean_az)), np.sin(np.radians(mean_az))])
-        offsets = centroid_xy[members] @ u
-        order = np.argsort(offsets)
-        cuts = np.flatnonzero(np.diff(offsets[order]) > config.plane_gap_m) + 1
-        groups.extend(members[order][piece] for piece in np.split(np.arange(len(order)), cuts))
+        tangent = np.array([-u[1], u[0]])
+        for plane in split_at_gaps(members, centroid_xy[members] @ u, config.plane_gap_m):
+            groups.extend(split_at_gaps(plane, centroid_xy[plane] @ tangent,
+                                        config.plane_extent_gap_m))
     min_area = config.min_group_area_m2(sum(float(facade_area_m2[g].sum()) for g in groups))
     kept = [g for g in groups if facade_area_m2[g].sum() >= min_area]
-    for i, members in enumerate(sorted(kept, key=lambda g: azimuth_offset(
+    for i, members in enumerate(sorted(kept, key=lambda g: facade_key(
             normal[g], centroid_xy[g], facade_area_m2[g]))):
         group[members] = i
     return group
+
+
+def split_at_gaps(members: np.ndarray, coordinate_m: np.ndarray, gap_m: float
+                  ) -> list[np.ndarray]:
+    """(N,) ``members`` cut into runs, in increasing (N,) ``coordinate_m``, wherever two
+    neighbouring coordinates lie more than ``gap_m`` apart."""
+    order = np.argsort(coordinate_m, kind="stable")
+    cuts = np.flatnonzero(np.diff(coordinate_m[order]) > gap_m) + 1
+    return [members[order][piece] for piece in np.split(np.arange(len(order)), cuts)]
+
+
+def facade_key(normal: np.ndarray, centroid_xy: np.ndarray, weight: np.ndarray
+               ) -> tuple[float, float, float]:
+    """The order of facades: weighted mean azimuth (deg), offset (m) along it, then the
+    weighted mean position (m) along the plane's tangent (pieces of one plane)."""
+    azimuth, offset = azimuth_offset(normal, centroid_xy, weight)
+    a = np.radians(azimuth)
+    return azimuth, offset, float(np.average(centroid_xy @ np.array([-np.sin(a), np.cos(a)]),
+                                             weights=weight))
 
 
 def _azimuth_peaks_deg(azimuth_deg: np.ndarray, weight: np.ndarray,

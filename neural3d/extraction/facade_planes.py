@@ -20,7 +20,10 @@ class FacadePlanes:
 
     ``azimuth_deg`` (K,) and ``offset_m`` (K,): plane k is {x : x.N_k = offset_m[k]}
     with N_k the horizontal unit normal at ``azimuth_deg[k]``, in increasing
-    azimuth then offset. ``weight`` (F, K): the share of triangle f's area that
+    azimuth, offset, then position along it. ``extent_m`` (K, 2): the stretch
+    [start, end] of plane k along its tangent (:func:`plane_frame`) that counts
+    triangles: its group's triangles' extent widened by ``plane_slab_m`` each way.
+    ``weight`` (F, K): the share of triangle f's area that
     counts on plane k (n.N_k, its shadow on the plane, divided by the cosine of
     its strip, see ``_strip_cosine``, unless it is a corner counted on two
     planes), else 0. ``residual`` (F,): 1 for facade triangles near no plane
@@ -32,6 +35,7 @@ class FacadePlanes:
     offset_m: np.ndarray
     weight: np.ndarray
     residual: np.ndarray
+    extent_m: np.ndarray
 
 
 def project_onto_facade_planes(
@@ -44,9 +48,13 @@ def project_onto_facade_planes(
 ) -> FacadePlanes:
     """Facade planes of a semantic mesh and the projected share of every triangle on them.
 
-    The facade groups propose planes; planes are taken greedily, most unclaimed
+    The facade groups propose planes, each bounded along its tangent by its group's
+    extent widened by ``plane_slab_m``; planes are taken greedily, most unclaimed
     projected facade area first, each claiming the unclaimed triangles near it
-    (``plane_slab_m``) that face it (within ``plane_max_angle_deg``); proposals
+    (``plane_slab_m``), within its extent, that face it (within
+    ``plane_max_angle_deg``) and that no parallel proposal (azimuths less than half
+    ``min_facade_separation_deg`` apart) holds nearer (a bay's front and the wall
+    behind it, or a window recessed in either, each count on their own); proposals
     left with less than the groups' minimum area are dropped. A triangle counts
     on the plane that claimed it and also on any other taken plane it is near
     and faces whose normal is at least ``plane_max_angle_deg`` away: the cut
@@ -73,10 +81,23 @@ def project_onto_facade_planes(
                                    facade_area_m2[group == k]) for k in range(group.max() + 1)]
         az = np.radians([a for a, _ in az_off])
         plane_n = np.stack([np.cos(az), np.sin(az)], axis=1)  # (K, 2)
+        plane_t = np.stack([-plane_n[:, 1], plane_n[:, 0]], axis=1)  # (K, 2) tangents
+        corners_xy = vertices_m[faces][:, :, :2]  # (F, 3, 2)
+        extents = np.array([[(corners_xy[group == k] @ plane_t[k]).min() - config.plane_slab_m,
+                             (corners_xy[group == k] @ plane_t[k]).max() + config.plane_slab_m]
+                            for k in range(len(az_off))])  # (K, 2)
         facing = normal[idx, :2] @ plane_n.T  # (I, K) n.N
         near = np.abs(centroid_xy[idx] @ plane_n.T - np.array([d for _, d in az_off]))
+        along = centroid_xy[idx] @ plane_t.T  # (I, K)
         cos_max = np.cos(np.radians(config.plane_max_angle_deg))
-        inlier = (near <= config.plane_slab_m) & (facing >= cos_max)
+        inlier = ((near <= config.plane_slab_m) & (facing >= cos_max)
+                  & (along >= extents[:, 0]) & (along <= extents[:, 1]))
+        parallel = np.abs(wrap_deg(np.degrees(az)[:, None] - np.degrees(az)[None, :])
+                          ) < config.min_facade_separation_deg / 2  # (K, K)
+        nearest = np.where(inlier, near, np.inf)  # (I, K)
+        nearest_parallel = np.stack([nearest[:, parallel[k]].min(axis=1)
+                                     for k in range(len(az_off))], axis=1)
+        inlier &= near <= nearest_parallel
         support = facade_area_m2[idx, None] * np.where(inlier, facing, 0.0)  # (I, K) m²
         min_area = config.min_group_area_m2(float(facade_area_m2[group >= 0].sum()))
         claimed_by = np.full(len(idx), -1)
@@ -88,7 +109,7 @@ def project_onto_facade_planes(
                 break
             claimed_by[(claimed_by < 0) & inlier[:, k]] = k
             taken.append(k)
-        taken.sort(key=lambda k: az_off[k])
+        taken.sort(key=lambda k: (*az_off[k], float(extents[k].mean())))
         weight_i = np.zeros((len(idx), len(taken)))
         for j, k in enumerate(taken):  # corners: shadows on the other walls they face
             apart = plane_n[claimed_by] @ plane_n[k] <= cos_max + 1e-9  # (I,) other facades
@@ -102,11 +123,13 @@ def project_onto_facade_planes(
             weight_i[flat, j] = facing[flat, k] / _strip_cosine(
                 normal[idx[flat], :2], centroid_xy[idx[flat]], facade_area_m2[idx[flat]],
                 plane_n[k], config.curve_strip_m, floor=cos_max)
+    extent = extents[taken] if taken else np.zeros((0, 2))
     weight = np.zeros((len(faces), len(taken)))
     weight[idx] = weight_i
     near_plane = np.zeros(len(faces), dtype=bool)
     if taken:
-        near_plane[idx] = (near[:, taken] <= config.plane_slab_m).any(axis=1)
+        within = (along[:, taken] >= extent[:, 0]) & (along[:, taken] <= extent[:, 1])
+        near_plane[idx] = ((near[:, taken] <= config.plane_slab_m) & within).any(axis=1)
     horizontal = np.linalg.norm(normal[:, :2], axis=1)
     # a reveal or a recess side is near a plane it does not face: its shadow is 0, not its area
     residual = (~near_plane & (facade_area_m2 > 0)
@@ -114,7 +137,7 @@ def project_onto_facade_planes(
     return FacadePlanes(
         azimuth_deg=np.array([az_off[k][0] for k in taken]),
         offset_m=np.array([az_off[k][1] for k in taken]),
-        weight=weight, residual=residual,
+        weight=weight, residual=residual, extent_m=extent,
     )
 
 

@@ -1,9 +1,13 @@
 """Building footprint: the zero contour of an SDF near the ground, as a shapely polygon.
 
-The SDF is sampled on a square grid of ``cell_m`` over the box's x/y extent on
+Two outlines. The **footprint** (:func:`footprint_from_sdf`) is the ground floor's: the
+SDF is sampled on a square grid of ``cell_m`` over the box's x/y extent on
 one or more horizontal planes ``z = heights_m`` and averaged over them
-(defaults in :class:`neural3d.extract.ExtractConfig`: 1 to 4 m, above the
-ground plane's reconstruction noise and below balconies and overhangs). Across
+(defaults in :class:`neural3d.extract.ExtractConfig`: 1 to 2.5 m, above the
+ground plane's reconstruction noise and below the lowest first floor, so that
+upper floors, bays and balconies that reach beyond the ground floor stay out).
+The **widest outline** (:func:`widest_outline_from_sdf`) is the union of the
+sections from the lowest of those planes to the box top: what a roof plan draws. Across
 a vertical wall the SDF does not change with z, so the average keeps the wall
 where it is while the independent wobbles of a trained field on each plane
 cancel. The grid is padded with one ring of positive (outside) samples so
@@ -21,7 +25,7 @@ vertical lines from the highest plane to the box top, at up to
 one sample per ``cell_m``: a line meets a surface where some sample is within
 half a cell of it (|SDF| <= cell_m / 2, or inside). A hole where most lines
 meet a surface is roofed over and is filled. This assumes no building has a
-roofed hole in its footprint at 1-4 m: a covered passage or a glass-roofed
+roofed hole in its footprint at 1-2.5 m: a covered passage or a glass-roofed
 courtyard would be filled (footprint biased high).
 """
 
@@ -101,15 +105,9 @@ def footprint_from_sdf(
         if not lo[2] <= height_m <= hi[2]:
             raise ValueError(f"footprint height {height_m} m lies outside the box's z range "
                              f"[{lo[2]:.3g}, {hi[2]:.3g}] m")
-    if not np.isfinite(cell_m) or cell_m <= 0:
-        raise ValueError(f"cell_m must be > 0, got {cell_m}")
     if min_area_m2 < 0:
         raise ValueError(f"min_area_m2 must be >= 0, got {min_area_m2}")
-    counts = np.floor((hi[:2] - lo[:2]) / cell_m + 1e-9).astype(int) + 1
-    if counts.max() > MAX_FOOTPRINT_CELLS:
-        raise ValueError(f"footprint grid of {tuple(counts)} cells is too large (at most "
-                         f"{MAX_FOOTPRINT_CELLS} per axis); raise cell_m")
-    xs, ys = (lo[i] + cell_m * np.arange(max(counts[i], 2)) for i in range(2))
+    xs, ys = _grid_axes(lo, hi, cell_m)
     values = np.mean([sample_sdf_plane(sdf_fn, xs, ys, h) for h in heights], axis=0)
     where = f"z = {heights[0]} m" if len(heights) == 1 else f"z = {heights} m"
     if values.min() >= 0:
@@ -123,6 +121,55 @@ def footprint_from_sdf(
         return polygon
     return fill_roofed_holes(polygon, sdf_fn, z_from_m=max(heights), z_to_m=float(hi[2]),
                              cell_m=cell_m)
+
+
+def widest_outline_from_sdf(
+    sdf_fn: SdfFn,
+    box_min_m: np.ndarray,
+    box_max_m: np.ndarray,
+    *,
+    from_height_m: float,
+    step_m: float,
+    cell_m: float,
+    min_area_m2: float,
+) -> Polygon | MultiPolygon:
+    """The widest outline (world x/y metres): where the SDF is negative on any plane from
+    ``from_height_m`` to the box top, ``step_m`` apart (the minimum of the planes' SDFs).
+
+    The union of every storey's section: upper floors, bays and balconies beyond the ground
+    floor are inside it. A part thinner than ``step_m`` (a balcony slab) may fall between
+    two planes. Pieces and holes smaller than ``min_area_m2`` are dropped; holes are kept
+    as they are (a courtyard open to the sky on every plane).
+
+    Raises
+    ------
+    ValueError
+        As :func:`footprint_from_sdf`, and if ``step_m`` is not > 0.
+    """
+    lo, hi = check_box(box_min_m, box_max_m)
+    if not step_m > 0:
+        raise ValueError(f"step_m must be > 0, got {step_m}")
+    if not lo[2] <= from_height_m <= hi[2]:
+        raise ValueError(f"from_height_m {from_height_m} m lies outside the box's z range "
+                         f"[{lo[2]:.3g}, {hi[2]:.3g}] m")
+    xs, ys = _grid_axes(lo, hi, cell_m)
+    values = np.min([sample_sdf_plane(sdf_fn, xs, ys, h)
+                     for h in np.arange(from_height_m, hi[2], step_m)], axis=0)
+    if values.min() >= 0:
+        raise ValueError("no plane meets the building (the SDF is positive everywhere on them)")
+    return _polygon_from_grid(values, xs[0], ys[0], cell_m, min_area_m2)
+
+
+def _grid_axes(lo: np.ndarray, hi: np.ndarray, cell_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """x and y sample positions (m) of a ``cell_m`` grid over the box's x/y extent."""
+    if not np.isfinite(cell_m) or cell_m <= 0:
+        raise ValueError(f"cell_m must be > 0, got {cell_m}")
+    counts = np.floor((hi[:2] - lo[:2]) / cell_m + 1e-9).astype(int) + 1
+    if counts.max() > MAX_FOOTPRINT_CELLS:
+        raise ValueError(f"footprint grid of {tuple(counts)} cells is too large (at most "
+                         f"{MAX_FOOTPRINT_CELLS} per axis); raise cell_m")
+    xs, ys = (lo[i] + cell_m * np.arange(max(counts[i], 2)) for i in range(2))
+    return xs, ys
 
 
 def fill_roofed_holes(

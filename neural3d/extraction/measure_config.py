@@ -78,7 +78,11 @@ class MeasureConfig:
     azimuth_bin_deg: float = 1.0
     azimuth_smoothing_deg: float = 3.0
     min_facade_separation_deg: float = 30.0
-    plane_gap_m: float = 1.0
+    # parallel planes: offsets more than plane_gap_m apart (deeper than the generator's
+    # deepest reveal, 0.5 m, so a window stays with its wall); pieces of one plane: more
+    # than plane_extent_gap_m apart along it (docs/decisions.md, 2026-11-29)
+    plane_gap_m: float = 0.5
+    plane_extent_gap_m: float = 1.0
     min_facade_area_m2: float = 1.0
     min_facade_area_fraction: float = 0.02
     # plane_projection (neural3d.extraction.facade_planes); plane_slab_m and
@@ -106,7 +110,8 @@ class MeasureConfig:
         if not 0.0 < self.min_facade_separation_deg <= 180.0:
             raise ValueError("min_facade_separation_deg must be in (0, 180], got "
                              f"{self.min_facade_separation_deg}")
-        for name in ("azimuth_smoothing_deg", "plane_gap_m", "min_facade_area_m2",
+        for name in ("azimuth_smoothing_deg", "plane_gap_m", "plane_extent_gap_m",
+                     "min_facade_area_m2",
                      "min_facade_area_fraction", "plane_slab_m"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")

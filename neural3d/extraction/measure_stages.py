@@ -145,10 +145,12 @@ def group_facades(state: MeasureState, config: MeasureConfig) -> MeasureState:
     (:mod:`neural3d.extraction.facade_groups`).
 
     Assumes vertical facades (within ``facade_max_tilt_deg``), walls at least
-    ``min_facade_separation_deg`` apart in azimuth and parallel walls at least
-    ``plane_gap_m`` apart. Biases the per-facade figures, not the whole building's:
-    a curved wall is cut into arbitrary segments, two walls closer in azimuth or
-    offset merge, and facades smaller than the minimum group are left out.
+    ``min_facade_separation_deg`` apart in azimuth, parallel walls at least
+    ``plane_gap_m`` apart and two facades of one plane at least ``plane_extent_gap_m``
+    apart along it. Biases the per-facade figures, not the whole building's: a curved
+    wall is cut into arbitrary segments, two walls closer in azimuth or offset merge, a
+    wall broken by a deep recess wider than ``plane_extent_gap_m`` becomes two facades,
+    and facades smaller than the minimum group are left out.
     """
     return replace(state, group=group_faces(state.vertices_m, state.faces,
                                             state.facade_area_m2, config))

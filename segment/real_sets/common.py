@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from segment.photo_io import read_photo_rgb
+from envelope.photo_io import read_photo_rgb
 
 PHOTO_TRAIN, PHOTO_VAL, PHOTO_TEST = "train", "val", "test"
 PHOTO_SPLITS = (PHOTO_TRAIN, PHOTO_VAL, PHOTO_TEST)

@@ -20,12 +20,13 @@ from pathlib import Path
 
 import pytest
 
-from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, TaskResources
+from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig
 from envelope.results import read_result
+from envelope.scenes.scene import find_scene_folders
 from metrics.compare import main
 from metrics.run.executors import make_executor
 from metrics.run.methods import method_specs
-from metrics.run.runner import MethodSpec, find_scenes, run_missing
+from metrics.run.runner import MethodSpec, run_missing
 
 pytestmark = pytest.mark.slow  # every test here starts a local Ray cluster
 
@@ -64,6 +65,10 @@ def _ctrl_c_raises():
 
 def _attempts(path: Path) -> list[str]:
     return path.read_text().splitlines() if path.is_file() else []
+
+
+def _a_gpu(config):
+    return 1.0, 1.0
 
 
 def _faulty_2ds(log: Path, die_on: set[str], *, always: bool = False,
@@ -111,10 +116,10 @@ def test_2d_methods_give_the_same_tables_with_ray_and_local(local_ray, tiny_benc
 
 def test_a_task_the_cluster_cannot_place_is_refused_and_names_are_checked(
         local_ray, tiny_benchmark, tmp_path):
-    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0],
-                   resources=TaskResources(cpus=1.0, gpus=1.0))
+    spec = method_specs(("2D-S",), ("ideal",), tmp_path)[0]
+    spec = replace(spec, method=replace(spec.method, reserve=_a_gpu))
     with pytest.raises(ValueError, match="needs 1 GPU"):
-        run_missing(find_scenes(tiny_benchmark), [spec], tmp_path / "results", log=_quiet,
+        run_missing(find_scene_folders(tiny_benchmark), [spec], tmp_path / "results", log=_quiet,
                     execute=make_executor("ray", CONFIG))
     assert not (tmp_path / "results").exists()
     with pytest.raises(ValueError, match="unknown executor"):
@@ -124,7 +129,7 @@ def test_a_task_the_cluster_cannot_place_is_refused_and_names_are_checked(
 @pytest.mark.slow
 def test_a_killed_worker_is_retried_and_no_result_is_lost_or_doubled(
         local_ray, tiny_benchmark, tmp_path):
-    scenes = find_scenes(tiny_benchmark)
+    scenes = find_scene_folders(tiny_benchmark)
     log = tmp_path / "attempts.txt"
     victim = scenes[0].name
     spec = _faulty_2ds(log, {victim})
@@ -143,7 +148,7 @@ def test_a_killed_worker_is_retried_and_no_result_is_lost_or_doubled(
 @pytest.mark.slow
 def test_retries_are_bounded_and_an_input_failure_is_not_retried(
         local_ray, tiny_benchmark, tmp_path):
-    scenes = find_scenes(tiny_benchmark)
+    scenes = find_scene_folders(tiny_benchmark)
     log = tmp_path / "attempts.txt"
     dies, fails = scenes[0].name, scenes[1].name
     spec = _faulty_2ds(log, {dies}, always=True, raise_on=frozenset({fails}))
@@ -190,7 +195,7 @@ def test_a_scene_reaches_the_worker_without_a_shared_folder(local_ray, tiny_benc
 @pytest.mark.slow
 def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
         local_ray, tiny_benchmark, tmp_path):
-    scenes = find_scenes(tiny_benchmark)
+    scenes = find_scene_folders(tiny_benchmark)
     results = tmp_path / "results"
     quick = method_specs(("2D-S",), ("ideal",), tmp_path)[0]
     started, finished = tmp_path / "slow-started", tmp_path / "slow-finished"

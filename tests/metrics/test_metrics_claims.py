@@ -104,11 +104,18 @@ def test_paper_figures_sit_beside_ours_where_the_paper_has_the_row():
 
 
 def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
+    from dataclasses import dataclass
+
+    from envelope.scenes.scene import find_scene_folders
     from envelope.truth import write_building
-    from metrics.run.runner import MethodSpec, find_scenes, run_missing
+    from metrics.run.runner import folder_spec, run_missing
+
+    @dataclass(frozen=True)
+    class Seeded:
+        seed: int
 
     write_building(tmp_path / "data" / "a" / "building.json", make_truth("a"))
-    scenes = find_scenes(tmp_path / "data")
+    scenes = find_scene_folders(tmp_path / "data")
     calls = []
 
     def run(scene_dir, protocol, seed):
@@ -116,7 +123,7 @@ def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
         return replace(make_result("a", "fake", protocol, 0.25 + seed / 100),
                        config={"seed": seed})
 
-    specs = [MethodSpec("fake", ("train",), {"seed": s}, lambda d, p, s=s: run(d, p, s), seed=s)
+    specs = [folder_spec("fake", ("train",), Seeded(s), lambda d, p, s=s: run(d, p, s))
              for s in (0, 1)]
     out = run_missing(scenes, specs, tmp_path / "results", log=lambda _: None)
     assert [(o.status, o.result.seed) for o in out] == [("ran", 0), ("ran", 1)]
@@ -128,7 +135,7 @@ def test_specs_differing_by_seed_run_and_are_reused_side_by_side(tmp_path):
 
 
 def test_claims_tables_leave_out_tables_without_rows():
-    from metrics.compare import claims_tables
+    from metrics.comparison import claims_tables
 
     rows = [BuildingErrors(s, "l_shaped", "2D-S", "ideal", wwr_ape=e) for s, e in (("a", 1.0),
                                                                                   ("b", 2.0))]
@@ -139,20 +146,29 @@ def test_claims_tables_leave_out_tables_without_rows():
 def test_report_sections_show_the_visible_table_with_its_intervals(tmp_path):
     from metrics.report.html_claims import claims_sections
     from metrics.report.html_report import table2_html, table3_html
+    from metrics.report.report_data import read_table_records, table_records
 
     rows = [BuildingErrors(s, "realistic", "neural3d", "train", wwr_ape=e, footprint_iou=0.97,
                            wwr_ape_visible=e / 2) for s, e in (("a", 2.0), ("b", 4.0))]
     groups = aggregate_by_family(rows)
     (tmp_path / "table2_visible.csv").write_text(to_csv(table2_visible_errors(groups)))
-    html = claims_sections(tmp_path)
+    visible = read_table_records((tmp_path / "table2_visible.csv").read_text())
+    html = claims_sections({"table2_visible": visible})
     assert "visible facade" in html and "1.50 ± 0.50 [1.00, 2.00]" in html
-    assert "seed" not in html.lower()  # no seed table written
+    assert "seed" not in html.lower()  # no seed table given
+    assert claims_sections({"table2_visible": table_records(table2_visible_errors(groups))}) \
+        == html  # in memory as read back
     from metrics.report.report import table2_errors, table3_footprint_iou
 
     names = {"neural3d": "BuildNet3D"}
-    paper2 = read_csv_rows(to_csv(paper_table2_comparison(groups, names)))
-    paper3 = read_csv_rows(to_csv(paper_table3_comparison(groups, names)))
-    t2 = table2_html(read_csv_rows(to_csv(table2_errors(groups))), paper2)
-    assert "3.00 ± 1.00 [2.00, 4.00]" in t2 and "3.50 ± 2.20" in t2  # ours, then the paper's
-    t3 = table3_html(read_csv_rows(to_csv(table3_footprint_iou(groups, {"neural3d"}))), paper3)
-    assert "BuildNet3D paper, Table 3" in t3 and "0.971" in t3
+    tables = (paper_table2_comparison(groups, names), paper_table3_comparison(groups, names),
+              table2_errors(groups), table3_footprint_iou(groups, {"neural3d"}))
+    in_memory = [table_records(t) for t in tables]
+    read_back = [read_table_records(to_csv(t)) for t in tables]
+    for paper2, paper3, table2, table3 in (in_memory, read_back):
+        t2 = table2_html(table2, paper2)
+        assert "3.00 ± 1.00 [2.00, 4.00]" in t2 and "3.50 ± 2.20" in t2  # ours, the paper's
+        t3 = table3_html(table3, paper3)
+        assert "BuildNet3D paper, Table 3" in t3 and "0.971" in t3
+    assert table2_html(*in_memory[2::-2]) == table2_html(*read_back[2::-2])
+    assert table3_html(in_memory[3], in_memory[1]) == table3_html(read_back[3], read_back[1])

@@ -72,3 +72,41 @@ def test_default_benchmark_announces_what_it_does(tmp_path):
     line = default.announce(("2D-S", "neural3d"), {"neural3d": 1000}, study.heavy_comparisons)
     assert "5 comparisons" in line
     assert f"about {5 * default.expected_minutes:g} minutes" in line
+
+
+def test_a_spec_is_its_method_bound_to_a_config(tmp_path):
+    """The spec holds the Method and the config it runs with; what it says of the method is
+    read off them (nothing copied that could disagree), and its results record its config."""
+    from dataclasses import replace
+
+    from envelope.method import built_in_method
+    from envelope.results import read_result
+    from envelope.scenes.scene import find_scene_folders
+    from metrics.run.runner import folder_spec, run_missing
+    from neural3d.method import record_config, reserve
+
+    budget = Neural3dBudget(seed=2, threads=3)
+    (n3d,) = method_specs(("neural3d",), ("ideal",), tmp_path, configs={"neural3d": budget},
+                          seeds=(2,))
+    method = built_in_method("neural3d")
+    assert n3d.method is method and n3d.method_config == budget
+    assert (n3d.name, n3d.paper_name, n3d.heavy) == (method.name, method.paper_name, True)
+    assert (n3d.mesh_file, n3d.libraries) == (method.mesh_file, method.libraries)
+    assert n3d.seed == 2 and n3d.artefacts_dir == tmp_path / "neural3d_runs" / "seed2"
+    assert (n3d.resources.cpus, n3d.resources.gpus) == reserve(budget) == (3.0, 0.0)
+    assert n3d.config == record_config(budget)
+    renamed = replace(n3d, method=replace(method, name="neural3d-b", paper_name=None))
+    assert (renamed.name, renamed.paper_name) == ("neural3d-b", None)
+
+    (data := tmp_path / "data" / "a").mkdir(parents=True)
+    (data / "building.json").write_text("{}")
+
+    def run(scene_dir, protocol):
+        from metrics_helpers import make_result
+
+        return replace(make_result("a", "fake", protocol, 0.5), config={"made": "by the run"})
+
+    spec = replace(folder_spec("fake", ("ideal",), {"k": 1}, run), conditions={"masks": "x"})
+    assert spec.config == {"k": 1, "masks": "x"} and spec.seed is None
+    (outcome,) = run_missing(find_scene_folders(data), [spec], tmp_path / "results", log=print)
+    assert read_result(outcome.path).config == {"k": 1, "masks": "x"}

@@ -16,7 +16,7 @@ from metrics.report.report import read_building_errors_csv
 from metrics.report.robustness_plot import plot_robustness
 from metrics.robustness import RobustnessStudy, robustness_table, summarise
 from metrics.run.degraded import CONFIG_KEY, with_degradation
-from metrics.run.runner import MethodSpec
+from metrics.run.runner import folder_spec
 from metrics.score.errors import BuildingErrors
 
 
@@ -54,7 +54,7 @@ def test_study_rejects_bad_levels() -> None:
 
 
 def test_degraded_specs_carry_the_degradation_in_their_configs() -> None:
-    spec = MethodSpec("2D-S", ("ideal",), {"a": 1}, lambda d, p: None)
+    spec = folder_spec("2D-S", ("ideal",), {"a": 1}, lambda d, p: None)
     (degraded,) = with_degradation([spec], parse_specs("pose:0.5"))
     record = [{"name": "pose", "severity": 0.5, "seed": 0}]
     assert degraded.config == {"a": 1, CONFIG_KEY: record}

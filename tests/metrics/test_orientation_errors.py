@@ -17,6 +17,7 @@ from metrics_helpers import make_benchmark
 
 from metrics.compare import main as compare_main
 from metrics.report.html_orientation import orientation_section
+from metrics.report.report_data import read_table_records, table_records
 from metrics.report.report_orientation import orientation_table
 from metrics.report.tables import read_csv_rows, write_table
 from metrics.score.aggregate import ALL_FAMILIES
@@ -92,9 +93,13 @@ def test_compare_writes_the_table_and_the_report_shows_it(tmp_path):
 
 
 def test_report_section_without_the_table_says_how_to_get_it(tmp_path):
-    assert "rerun `python -m metrics.compare`" in orientation_section(tmp_path)
-    write_table(orientation_table(summarise_orientations(orientation_errors(
-        ideal_result(), box_truth()))), tmp_path)
-    html = orientation_section(tmp_path)
+    assert "rerun `python -m metrics.compare`" in orientation_section(None)
+    table = orientation_table(summarise_orientations(orientation_errors(
+        ideal_result(), box_truth())))
+    write_table(table, tmp_path)
+    html = orientation_section(table_records(table))
     assert html.count("<tr") == 1 + 8  # header + (skyscraper, all) x 4 bins
     assert "5.00 ± 0.00" in html and "chart-orientation" in html
+    # the same section from the table in memory and read back from its CSV
+    read_back = read_table_records((tmp_path / f"{ORIENTATION_TABLE_NAME}.csv").read_text())
+    assert orientation_section(read_back) == html

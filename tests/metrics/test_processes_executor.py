@@ -17,12 +17,12 @@ from pathlib import Path
 
 import pytest
 
-from envelope.executors.ray_tasks import TaskResources
 from envelope.progress import progress_bar
 from envelope.results import read_result
+from envelope.scenes.scene import find_scene_folders
 from metrics.run.executors import make_executor
 from metrics.run.methods import method_specs
-from metrics.run.runner import find_scenes, run_missing
+from metrics.run.runner import run_missing
 from neural3d.method import METHOD_NEURAL3D, Neural3dBudget, record_config, reserve
 
 
@@ -35,6 +35,17 @@ def _dies_on_first_scene(scene_dir, protocol):
     if scene_dir.name == "tiny_l_shaped":
         os._exit(3)
     return method_specs(("2D-S",), ("ideal",), scene_dir.parent)[0].run(scene_dir, protocol)
+
+
+def _reserve(cpus, config):
+    return cpus, 0.0
+
+
+def _heavy_2ds(tmp_path, cpus=1.0, **spec_fields):
+    """2D-S on the ideal views, declared heavy, reserving ``cpus`` cores a run."""
+    spec = method_specs(("2D-S",), ("ideal",), tmp_path)[0]
+    method = replace(spec.method, heavy=True, reserve=partial(_reserve, cpus))
+    return replace(spec, method=method, **spec_fields)
 
 
 def _2ds_noting_its_process(folder, scene_dir, protocol):
@@ -60,9 +71,9 @@ def _without_times(outcomes):
 
 @pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path):
-    scenes = find_scenes(tiny_benchmark)
+    scenes = find_scene_folders(tiny_benchmark)
     light = method_specs(("2D-SS",), ("ideal",), tmp_path)[0]
-    heavy = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True)
+    heavy = _heavy_2ds(tmp_path)
     local = run_missing(scenes, [light, heavy], tmp_path / "local", log=_quiet)
     processes = run_missing(scenes, [light, heavy], tmp_path / "processes", log=_quiet,
                             execute=make_executor("processes", cpus=2))
@@ -74,13 +85,11 @@ def test_heavy_runs_in_processes_give_the_local_results(tiny_benchmark, tmp_path
 
 @pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path):
-    scenes = find_scenes(tiny_benchmark)
+    scenes = find_scene_folders(tiny_benchmark)
     for cores, expect_here in ((1.0, False), (2.0, True)):
         pids = tmp_path / f"pids-{cores}"
         pids.mkdir()
-        spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
-                       run=partial(_2ds_noting_its_process, str(pids)),
-                       resources=TaskResources(cpus=cores))
+        spec = _heavy_2ds(tmp_path, cores, run=partial(_2ds_noting_its_process, str(pids)))
         outcomes = run_missing(scenes, [spec], tmp_path / f"results-{cores}", log=_quiet,
                                execute=make_executor("auto", cpus=2))
         assert [o.status for o in outcomes] == ["ran"] * 3
@@ -90,9 +99,8 @@ def test_auto_runs_heavy_runs_at_once_only_when_two_fit(tiny_benchmark, tmp_path
 
 @pytest.mark.slow  # processes start in seconds: kept out of the fast subset
 def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
-    scenes = find_scenes(tiny_benchmark)
-    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
-                   run=_dies_on_first_scene)
+    scenes = find_scene_folders(tiny_benchmark)
+    spec = _heavy_2ds(tmp_path, run=_dies_on_first_scene)
     messages = []
     outcomes = run_missing(scenes, [spec], tmp_path / "results", log=messages.append,
                            execute=make_executor("processes", cpus=2))
@@ -108,9 +116,8 @@ def test_a_run_whose_process_dies_fails_alone(tiny_benchmark, tmp_path):
 
 @pytest.mark.slow
 def test_a_heavy_run_s_progress_is_shown_by_the_parent(tiny_benchmark, tmp_path, capsys):
-    scenes = find_scenes(tiny_benchmark)[:2]
-    spec = replace(method_specs(("2D-S",), ("ideal",), tmp_path)[0], heavy=True,
-                   run=_2ds_after_a_counted_loop)
+    scenes = find_scene_folders(tiny_benchmark)[:2]
+    spec = _heavy_2ds(tmp_path, run=_2ds_after_a_counted_loop)
     outcomes = run_missing(scenes, [spec], tmp_path / "results", log=_quiet,
                            execute=make_executor("processes", cpus=2))
     assert [o.status for o in outcomes] == ["ran"] * 2
@@ -150,12 +157,12 @@ def test_neural3d_trained_two_at_a_time_gives_the_local_results(tiny_benchmark, 
         done = subprocess.run(command, capture_output=True, text=True, timeout=600)
         assert done.returncode == 0, done.stderr[-3000:]
         if executor == "processes":  # each training's progress reached the parent's log
-            for scene in find_scenes(tiny_benchmark):
+            for scene in find_scene_folders(tiny_benchmark):
                 assert re.search(rf"neural3d {scene.name}: \d+/20 steps", done.stderr)
         results[executor] = {p.name: replace(read_result(p), wall_time_s=0.0)
                              for p in sorted((out / "results").glob("*.json"))}
         runs = sorted(p.name for p in (out / "results" / "neural3d_runs").iterdir())
-        assert runs == sorted(s.name for s in find_scenes(tiny_benchmark))
+        assert runs == sorted(s.name for s in find_scene_folders(tiny_benchmark))
     assert len(results["local"]) == 3
     assert results["processes"] == results["local"]  # every field, the provenance included
 
@@ -204,7 +211,7 @@ def test_ctrl_c_stops_the_trainings_with_checkpoints_and_whole_results(
     assert time.monotonic() - tic < 60 and "interrupted" in stderr
     written = sorted(p for p in results.iterdir() if p.is_file())
     assert [p.name for p in written] == [f"{s.name}__2D-S__ideal.json"
-                                         for s in find_scenes(tiny_benchmark)]
+                                         for s in find_scene_folders(tiny_benchmark)]
     for path in written:
         read_result(path)
     started = [p for p in runs.iterdir() if (p / "config.json").exists()]

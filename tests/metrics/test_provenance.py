@@ -15,11 +15,12 @@ from envelope.provenance import (
     provenance_changes,
 )
 from envelope.results import read_result, write_result
+from envelope.scenes.scene import find_scene_folders
 from envelope.truth import write_building
 from metrics.compare import main
 from metrics.report.report import table2_errors
 from metrics.report.tables import read_csv_rows
-from metrics.run.runner import MethodSpec, find_scenes, run_missing
+from metrics.run.runner import MethodSpec, folder_spec, run_missing
 from metrics.score.aggregate import aggregate_by_family
 from metrics.score.errors import building_errors
 
@@ -52,7 +53,7 @@ def _scenes(root: Path, names=("a", "b")) -> list[Path]:
     for name in names:
         write_building(root / name / "building.json", make_truth(name))
         (root / name / "transforms.json").write_text(f'{{"render": "{name} v1"}}')
-    return find_scenes(root)
+    return find_scene_folders(root)
 
 
 def _toy_spec(tmp_path: Path, name: str, wwr: float) -> MethodSpec:
@@ -64,7 +65,7 @@ def _toy_spec(tmp_path: Path, name: str, wwr: float) -> MethodSpec:
         return importlib.reload(module).run(make_result("x", name, protocol, 0.0), scene_dir,
                                             protocol)
 
-    return MethodSpec(name, ("ideal",), {"weighting": "area"}, run, code=(name,))
+    return folder_spec(name, ("ideal",), {"weighting": "area"}, run, packages=(name,))
 
 
 def test_changing_a_methods_source_recomputes_its_results_only(tmp_path, monkeypatch):
@@ -75,6 +76,7 @@ def test_changing_a_methods_source_recomputes_its_results_only(tmp_path, monkeyp
     first = run_missing(scenes, specs, results, log=lambda _: None)
     assert [o.status for o in first] == ["ran"] * 4
     assert read_result(results / "a__toy_method_a__ideal.json").provenance.code == {
+        "envelope": code_fingerprint("envelope"),
         "toy_method_a": code_fingerprint("toy_method_a")}
     again = run_missing(scenes, specs, results, log=lambda _: None)
     assert [o.status for o in again] == ["reused"] * 4  # an unchanged rerun computes nothing

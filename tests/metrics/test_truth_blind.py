@@ -1,5 +1,5 @@
 """Methods never see the truth: every built-in method, run the way metrics runs it, gives
-identical results on a scene copy whose truth is poisoned or gone (DESIGN.md).
+identical results on a scene copy whose truth is poisoned or gone (docs/DESIGN.md).
 
 The poisoned copy has another building's ``building.json`` and ``mesh.ply``, no facade-id
 (``instances/``) or normal images, and another generator record in ``transforms.json``.

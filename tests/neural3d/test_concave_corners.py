@@ -9,8 +9,9 @@ and taking its truth from that building's outline:
   it: the building is the sharp L (40 m of walls, 240 m² of facade);
 - the same mesh taken as built: the truth is the chamfered L's (39.3 m, 235.8 m²) and the
   stage counts the sharp L's, its stated bias;
-- the sharp L meshed from its exact signed distance (``bench/oracle_measure.py``), as a
-  perfect field gives it: the stage leaves it within 0.1 m².
+- the sharp L meshed from its exact signed distance
+  (:class:`neural3d.extraction.oracle.OracleField`), as a perfect field gives it: the stage
+  leaves it within 0.1 m².
 """
 
 
@@ -117,9 +118,9 @@ def test_a_sharp_corner_from_a_perfect_field_is_left_where_it_is():
     the corner is rounded by under a voxel, and the stage moves the facade by under
     0.1 m² (the mesh's own shortfall, about a voxel's height of wall at the roof and the
     ground, is the count's, not the stage's)."""
-    from bench.oracle_measure import OracleField
     from envelope.mesh import LabelledMesh
     from neural3d.extraction.meshing import extract_mesh, label_vertices
+    from neural3d.extraction.oracle import OracleField
 
     mesh, face_label = _prism(0.0)
     truth = LabelledMesh(mesh.vertices, mesh.faces, face_label, np.zeros(len(face_label)))

@@ -15,6 +15,7 @@ import neural3d.field.trained
 from envelope.classes import CLASS_NAMES
 from envelope.footprint import geojson_to_polygon
 from envelope.results import read_result, result_filename
+from envelope.scenes.scene import read_method_input
 from envelope.semantic_ply import read_semantic_ply
 from envelope.truth import FacadeTruth
 from metrics.score.errors import facade_errors
@@ -121,7 +122,7 @@ def test_evaluation_matches_the_own_facades_to_the_truth(scene_dir):
 
 
 @pytest.mark.slow
-def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
+def test_extract_run_writes_four_files(scene_dir, tmp_path, monkeypatch):
     monkeypatch.setattr(neural3d.field.trained, "load_trained_field",
                         lambda run_dir, device, step=None: AnalyticField(scene_dir))
     run_dir = tmp_path / "run"
@@ -133,6 +134,9 @@ def test_extract_run_writes_three_files(scene_dir, tmp_path, monkeypatch):
     assert len(f) > 1000 and set(np.unique(labels)) <= {0, 1, 2, 3}
     poly = geojson_to_polygon(json.loads((out / "footprint.geojson").read_text()))
     assert poly.area == pytest.approx(24.0, rel=0.01)
+    # a box: its widest outline is its footprint
+    widest = geojson_to_polygon(json.loads((out / "footprint_widest.geojson").read_text()))
+    assert widest.symmetric_difference(poly).area < 0.01 * poly.area
 
 
 def test_cli_errors_are_one_line(tmp_path, capsys):
@@ -161,7 +165,7 @@ def test_extract_run_on_a_trained_run(box_building, tmp_path):
 
     scene = write_ring_scene(box_building, tmp_path / "box", size_px=24, n_train=8, n_eval=0)
     config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
-    run_dir = train(scene, config, tmp_path / "runs", device=torch.device("cpu"))
+    run_dir = train(read_method_input(scene), config, tmp_path / "runs", device=torch.device("cpu"))
     out = tmp_path / "out"
     assert main(["--run", str(run_dir), "--resolution", "24", "--out", str(out),
                  "--without", "occluded_fill,roofed_hole_fill"]) == 0

@@ -130,6 +130,43 @@ def test_averaging_planes_cancels_wobbles_of_the_walls():
     assert _iou(band, truth) >= 0.995 > 0.97 > _iou(one, truth)
 
 
+def _overhang_sdf(p):
+    # ground floor 10 x 6 m up to 2.7 m (the lowest first floor); the floors above reach
+    # 1.5 m further out at the front (y < 0) and 1 m at the east end, up to 12 m
+    return np.minimum(box_sdf(p, [0, 0, 0], [10, 6, 2.7]), box_sdf(p, [0, -1.5, 2.7], [11, 6, 12]))
+
+
+def test_the_ground_floor_planes_give_the_ground_outline_under_an_overhang():
+    from neural3d.extraction.extract_config import (
+        GROUND_FLOOR_HEIGHTS_M,
+        ExtractConfig,
+        footprint_heights_m,
+    )
+
+    config = ExtractConfig(footprint_heights_m=GROUND_FLOOR_HEIGHTS_M)
+    heights = footprint_heights_m(np.array([12.0, 8.0, 13.0]), config)
+    ground = _footprint(_overhang_sdf, heights_m=heights)
+    truth = rectangle(0, 0, 10, 6)
+    assert _iou(ground, truth) >= 0.995
+    assert ground.area == pytest.approx(60.0, rel=0.005)
+    # the default planes (1-4 m) take part of the overhang into the outline
+    default = _footprint(_overhang_sdf, heights_m=ExtractConfig().footprint_heights_m)
+    assert _iou(default, truth) < 0.97
+
+
+def test_widest_outline_is_the_union_of_the_storeys():
+    from neural3d.extraction.footprint import widest_outline_from_sdf
+
+    widest = widest_outline_from_sdf(_overhang_sdf, SCENE_LO, SCENE_HI, from_height_m=1.0,
+                                     step_m=0.5, cell_m=0.1, min_area_m2=1.0)
+    truth = rectangle(0, -1.5, 11, 6)
+    assert _iou(widest, truth) >= 0.995
+    assert widest.area == pytest.approx(11 * 7.5, rel=0.005)
+    with pytest.raises(ValueError, match="step_m"):
+        widest_outline_from_sdf(_overhang_sdf, SCENE_LO, SCENE_HI, from_height_m=1.0,
+                                step_m=0.0, cell_m=0.1, min_area_m2=1.0)
+
+
 def test_extract_keeps_footprint_planes_below_half_the_box():
     from neural3d.extraction.extract_config import ExtractConfig, footprint_heights_m
 

@@ -118,7 +118,7 @@ def test_occupancy_grid_matches_the_cpu(fast_setup):
 
 @pytest.fixture(scope="module")
 def cuda_run(scene, tmp_path_factory):
-    return train(scene, SHORT, tmp_path_factory.mktemp("runs"), device=CUDA)
+    return train(read_method_input(scene), SHORT, tmp_path_factory.mktemp("runs"), device=CUDA)
 
 
 def test_training_on_cuda_fits_the_box_and_loads_on_the_cpu(cuda_run):

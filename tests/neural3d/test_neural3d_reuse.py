@@ -38,7 +38,7 @@ def config_of(steps):
 def test_prior_run_tells_finished_partial_and_other(scene, tmp_path):
     torch.set_num_threads(1)
     config = config_of(STEPS)
-    run = train(scene, config, tmp_path, device=CPU)
+    run = train(read_method_input(scene), config, tmp_path, device=CPU)
     expected = training_provenance(scene, config, CPU)
     assert prior_run(run, expected, STEPS) == "finished"
     assert prior_run(run, expected, STEPS + 10) == "partial"
@@ -77,7 +77,7 @@ def test_second_run_reuses_the_training_and_measures_the_same(scene, tmp_path):
 def test_a_partial_run_is_resumed_to_the_budget(scene, tmp_path):
     torch.set_num_threads(BUDGET.threads)
     half = config_of(STEPS // 2)
-    train(scene, half, tmp_path, device=CPU)
+    train(read_method_input(scene), half, tmp_path, device=CPU)
     run = tmp_path / scene_name(scene)
     # The half run's folder, relabelled as a run of the full budget stopped at step 10
     # (as Ctrl-C leaves it): same config but for the step budget.
@@ -94,6 +94,35 @@ def test_a_partial_run_is_resumed_to_the_budget(scene, tmp_path):
     # (eval_every 50): step 10's evaluation survives only if the run was resumed.
     evals = json.loads((run / "eval.json").read_text())["evaluations"]
     assert [e["step"] for e in evals] == [10, STEPS]
+
+
+@pytest.mark.slow
+def test_the_method_trains_on_the_input_it_is_given_and_writes_no_result(scene, tmp_path,
+                                                                          monkeypatch):
+    """neural3d reads its scene once: training takes the MethodInput it is given (here with
+    every other train frame left out) and never reads the folder's transforms.json again;
+    the result comes back with the config the method records, and only the runner writes
+    it (the run folder keeps the mesh and the footprint)."""
+    import envelope.scenes.scene as scenes
+    from neural3d.method import EXTRACT_FOLDER, record_config
+
+    read = read_method_input(scene)
+    train_ids = [i for i, f in enumerate(read.frames) if f.split == "train"]
+    dropped = set(train_ids[::2])
+    given = replace(read, frames=tuple(f for i, f in enumerate(read.frames) if i not in dropped))
+
+    def no_second_read(root):
+        raise AssertionError(f"{root} read again")
+
+    monkeypatch.setattr(scenes, "_read_transforms", no_second_read)
+    result = run_neural3d(given, "train", BUDGET, artefacts_dir=tmp_path)
+    run = tmp_path / scene_name(scene)
+    assert json.loads((run / "run.json").read_text())["train_frames"] == (
+        len(train_ids) - len(dropped))
+    assert result.config == replace(result, config=record_config(BUDGET)).config
+    assert result.steps == STEPS
+    assert not [p.name for p in (run / EXTRACT_FOLDER).iterdir() if p.suffix == ".json"]
+    assert (run / EXTRACT_FOLDER / "mesh.ply").is_file()
 
 
 def _neural3d_imports(module: str) -> set[str]:

@@ -11,6 +11,7 @@ import torch
 from neural3d_scene import write_ring_scene
 from paths import REPO_ROOT
 
+from envelope.scenes.scene import read_method_input
 from neural3d.config import preset_config
 from neural3d.method import RUNS_FOLDER
 from neural3d.train import train
@@ -27,7 +28,8 @@ def _bench(*args: str) -> subprocess.CompletedProcess:
 def test_the_stage_bench_checks_its_own_figures_float_for_float(box_building, tmp_path):
     scene = write_ring_scene(box_building, tmp_path / "box", size_px=24, n_train=8, n_eval=0)
     config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
-    train(scene, config, tmp_path / "results" / RUNS_FOLDER, device=torch.device("cpu"))
+    train(read_method_input(scene), config, tmp_path / "results" / RUNS_FOLDER,
+          device=torch.device("cpu"))
     saved = tmp_path / "before.json"
     args = ("--results", str(tmp_path / "results"), "--resolution", "24", "--threads", "1",
             "--without", "concave_corner_fill")

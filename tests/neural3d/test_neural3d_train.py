@@ -11,6 +11,7 @@ from conftest import BOX_SIZE_M
 from neural3d_scene import write_ring_scene
 from paths import REPO_ROOT
 
+from envelope.scenes.scene import read_method_input
 from neural3d.config import preset_config
 from neural3d.field.checkpoint import read_checkpoint
 from neural3d.field.trained import load_trained_field
@@ -32,7 +33,7 @@ def scene(box_building, tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def short_run(scene, tmp_path_factory):
-    return train(scene, SHORT, tmp_path_factory.mktemp("runs"), device=CPU)
+    return train(read_method_input(scene), SHORT, tmp_path_factory.mktemp("runs"), device=CPU)
 
 
 def box_surface_points(n, seed=0):
@@ -85,15 +86,15 @@ def one_thread():
 def _interrupted_and_resumed(scene, tmp_path):
     config = replace(preset_config("tiny"), iterations=6, rays_per_batch=32, eval_every=3,
                      checkpoint_every=100)
-    straight = train(scene, config, tmp_path / "a", device=CPU)
+    straight = train(read_method_input(scene), config, tmp_path / "a", device=CPU)
 
     def interrupt(step, field):
         raise KeyboardInterrupt  # as Ctrl-C would, after step 3
 
     with pytest.raises(KeyboardInterrupt):
-        train(scene, config, tmp_path / "b", device=CPU, callback=interrupt)
+        train(read_method_input(scene), config, tmp_path / "b", device=CPU, callback=interrupt)
     assert read_checkpoint(tmp_path / "b" / "box" / "checkpoint.pt", CPU)["step"] == 3
-    resumed = train(scene, config, tmp_path / "b", device=CPU, resume=True)
+    resumed = train(read_method_input(scene), config, tmp_path / "b", device=CPU, resume=True)
     return (read_checkpoint(straight / "checkpoint.pt", CPU),
             read_checkpoint(resumed / "checkpoint.pt", CPU))
 
@@ -117,7 +118,8 @@ def test_resume_matches_uninterrupted_run(scene, tmp_path, one_thread):
 def test_callback_stops_early(scene, tmp_path):
     config = replace(preset_config("tiny"), iterations=50, rays_per_batch=16, eval_every=2)
     seen = []
-    run = train(scene, config, tmp_path, device=CPU, callback=lambda s, f: seen.append(s) or True)
+    run = train(read_method_input(scene), config, tmp_path, device=CPU,
+                callback=lambda s, f: seen.append(s) or True)
     assert seen == [2]
     assert read_checkpoint(run / "checkpoint.pt", CPU)["step"] == 2
 
@@ -144,15 +146,15 @@ def test_scene_errors(scene, tmp_path):
     shutil.copytree(scene, copy)
     _edit_transforms(copy, lambda m: [f.update(split="eval") for f in m["frames"]])
     with pytest.raises(ValueError, match="no 'train' frames"):
-        train(copy, SHORT, tmp_path / "runs", device=CPU)
+        train(read_method_input(copy), SHORT, tmp_path / "runs", device=CPU)
     _edit_transforms(copy, lambda m: [f.update(split="train") for f in m["frames"]])
     _edit_transforms(copy, lambda m: m.update(w=40))
     with pytest.raises(ValueError, match="is 32x32 but transforms.json says 40x32"):
-        train(copy, SHORT, tmp_path / "runs", device=CPU)
+        train(read_method_input(copy), SHORT, tmp_path / "runs", device=CPU)
     with pytest.raises(ValueError, match="unknown device"):
-        train(scene, SHORT, tmp_path / "runs", device="tpu-9")
+        train(read_method_input(scene), SHORT, tmp_path / "runs", device="tpu-9")
     with pytest.raises(ValueError, match="cannot resume"):
-        train(scene, SHORT, tmp_path / "fresh", device=CPU, resume=True)
+        train(read_method_input(scene), SHORT, tmp_path / "fresh", device=CPU, resume=True)
 
 
 def test_cli_reports_errors_in_one_line(tmp_path, capsys):
@@ -170,7 +172,7 @@ def test_mlp_backbone_and_finite_difference_normals_train(scene, tmp_path):
     model = replace(tiny.model, backbone="mlp", mlp_hidden=64, mlp_layers=4, mlp_skip=2,
                     normals="finite_difference")
     config = replace(tiny, model=model, iterations=3, rays_per_batch=16, eval_every=3)
-    run = train(scene, config, tmp_path, device=CPU)
+    run = train(read_method_input(scene), config, tmp_path, device=CPU)
     field = load_trained_field(run, device=CPU)
     assert torch.isfinite(field.sdf_m(torch.zeros(4, 3))).all()
 
@@ -215,7 +217,7 @@ def test_training_with_occupancy_grid_refreshes_and_checkpoints_it(scene, tmp_pa
     config = replace(preset_config("tiny"), iterations=6, rays_per_batch=32, eval_every=6,
                      checkpoint_every=6, occupancy_resolution=16, occupancy_start=2,
                      occupancy_every=2)
-    run = train(scene, config, tmp_path, device=CPU)
+    run = train(read_method_input(scene), config, tmp_path, device=CPU)
     state = read_checkpoint(run / "checkpoint.pt", CPU)
     occupied = state["occupancy"]
     assert occupied.dtype == torch.bool and 0 < occupied.float().mean() < 1  # refreshed
@@ -240,7 +242,7 @@ def test_training_with_ema_checkpoints_and_loads_the_averaged_field(scene, tmp_p
     config = replace(preset_config("tiny"), iterations=4, rays_per_batch=16, eval_every=4,
                      checkpoint_every=4, ema_decay=0.5)
     seen = []
-    run = train(scene, config, tmp_path, device=CPU,
+    run = train(read_method_input(scene), config, tmp_path, device=CPU,
                 callback=lambda s, f: seen.append(f.field.state_dict()["log_inv_s"].item()))
     state = read_checkpoint(run / "checkpoint.pt", CPU)
     assert state["ema"].keys() == state["field"].keys()

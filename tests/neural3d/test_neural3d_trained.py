@@ -6,6 +6,7 @@ import pytest
 import torch
 from neural3d_scene import write_ring_scene
 
+from envelope.scenes.scene import read_method_input
 from neural3d.config import preset_config
 from neural3d.field.trained import load_trained_field
 from neural3d.train import train
@@ -18,7 +19,8 @@ def field(box_building, tmp_path_factory):
     root = tmp_path_factory.mktemp("t")
     scene = write_ring_scene(box_building, root / "box", size_px=16, n_train=8, n_eval=0)
     config = replace(preset_config("tiny"), iterations=2, rays_per_batch=16)
-    return load_trained_field(train(scene, config, root / "runs", device=CPU), device=CPU)
+    run = train(read_method_input(scene), config, root / "runs", device=CPU)
+    return load_trained_field(run, device=CPU)
 
 
 @pytest.mark.slow

@@ -11,6 +11,7 @@ import torch
 from neural3d_scene import write_ring_scene
 from paths import REPO_ROOT
 
+from envelope.scenes.scene import read_method_input
 from envelope.truth import write_building
 from neural3d.config import preset_config
 from neural3d.extraction.extract_config import ExtractConfig
@@ -28,7 +29,8 @@ def test_the_walls_bench_tables_the_contour_and_each_setting(box_building, tmp_p
     scene = write_ring_scene(box_building, tmp_path / "box", size_px=24, n_train=8, n_eval=0)
     write_building(scene / "building.json", box_building.truth)  # the truth to compare with
     config = replace(preset_config("tiny"), iterations=4, eval_every=1000, checkpoint_every=1000)
-    train(scene, config, tmp_path / "results" / RUNS_FOLDER, device=torch.device("cpu"))
+    train(read_method_input(scene), config, tmp_path / "results" / RUNS_FOLDER,
+          device=torch.device("cpu"))
     out = tmp_path / "walls.json"
     done = _bench("--results", str(tmp_path / "results"), "--resolution", "24",
                   "--tolerances", "0.1", "0.2", "--min-walls", "1", "--threads", "1",

@@ -1,16 +1,20 @@
-"""bench/oracle_measure.py: the truth mesh as a perfect field (exact signed distance, inside as
-the union of closed bodies, one-hot classes of the nearest face) and the bench's own figures."""
+"""neural3d.extraction.oracle: the truth mesh as a perfect field (exact signed distance, inside
+as the union of closed bodies, one-hot classes of the nearest face), and bench/oracle_measure.py
+(run as its command) measuring on it."""
 
 import json
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 import torch
 import trimesh
+from paths import REPO_ROOT
 
-from bench.oracle_measure import OracleField, main, scene_box_m
 from envelope.classes import NUM_CLASSES, SemanticClass
 from envelope.mesh import LabelledMesh
+from neural3d.extraction.oracle import OracleField, scene_box_m
 
 WALL, ROOF = int(SemanticClass.WALL), int(SemanticClass.ROOF)
 VOXEL_M = 0.1
@@ -88,13 +92,19 @@ def test_a_body_that_is_not_closed_is_refused():
         _field(open_box)
 
 
-def test_the_bench_prints_and_writes_bias_and_error_per_stage_set(tmp_path, capsys):
+def _bench(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "bench.oracle_measure", *args], cwd=REPO_ROOT,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.mark.slow
+def test_the_bench_prints_and_writes_bias_and_error_per_stage_set(tmp_path):
     out = tmp_path / "oracle.json"
-    assert main(["--preset", "tiny", "--buildings", "tiny_skyscraper", "--resolution", "40",
-                 "--without", "concave_corner_fill", "--json", str(out)]) == 0
-    printed = capsys.readouterr().out
-    assert "| stages | family (buildings) | WWR bias % | WWR APE % |" in printed
-    assert "| -concave_corner_fill | tiny_skyscraper |" in printed
+    done = _bench("--preset", "tiny", "--buildings", "tiny_skyscraper", "--resolution", "40",
+                  "--without", "concave_corner_fill", "--json", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "| stages | family (buildings) | WWR bias % | WWR APE % |" in done.stdout
+    assert "| -concave_corner_fill | tiny_skyscraper |" in done.stdout
     (building,) = json.loads(out.read_text())["buildings"]
     assert set(building["sets"]) == {"all", "-concave_corner_fill"}
     truth = building["truth"]
@@ -103,5 +113,5 @@ def test_the_bench_prints_and_writes_bias_and_error_per_stage_set(tmp_path, caps
         assert bias["wwr"] == pytest.approx(100 * (result["wwr"] / truth["wwr"] - 1))
         assert abs(bias["facade"]) == pytest.approx(errors["facade_ape"])
         assert abs(bias["facade"]) < 10 and errors["footprint_iou"] > 0.9  # 0.9 m voxels
-    with pytest.raises(SystemExit):
-        main(["--preset", "tiny", "--buildings", "nowhere"])
+    refused = _bench("--preset", "tiny", "--buildings", "nowhere")
+    assert refused.returncode == 2 and "no building(s) ['nowhere']" in refused.stderr

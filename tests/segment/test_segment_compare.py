@@ -12,7 +12,7 @@ from segment_plugin import install_toy_plugin
 from metrics.compare import main
 from metrics.predicted_masks import exact_vs_predicted_table
 from metrics.run.predicted_masks import MasksRequest, masks_key, parse_masks, splits_read
-from metrics.run.runner import MethodSpec
+from metrics.run.runner import folder_spec
 from metrics.score.errors import BuildingErrors
 from segment.evaluate import SceneIou
 from segment.segmenter import Segmenter
@@ -36,7 +36,7 @@ def test_keys_name_the_segmenter_and_its_weights():
 
 def test_only_the_splits_the_methods_read_are_segmented():
     def spec(*protocols):
-        return MethodSpec("m", protocols, {}, run=len)
+        return folder_spec("m", protocols, {}, run=len)
 
     assert splits_read([spec("ideal", "multi")]) == ("ideal", "multi")
     assert splits_read([spec("ideal"), spec("train")]) == ("eval", "ideal", "train")
@@ -124,25 +124,27 @@ def test_a_plugin_with_wrong_answers_stops_the_run_and_leaves_no_masks(one_scene
 
 
 def test_a_method_on_predicted_masks_still_travels_to_another_process(one_scene, tmp_path):
-    """The wrapped run pickles (the processes and Ray executors send it to another process)
-    and, unpickled, gives the method's result with the segmenter in its config."""
+    """The spec on predicted masks pickles (the processes and Ray executors send it to
+    another process), runs there as the method does, and its results record the segmenter."""
     import pickle
     from dataclasses import replace
 
+    from envelope.results import read_result
     from metrics.run.methods import method_specs
     from metrics.run.predicted_masks import CONFIG_KEY, with_predicted_masks
+    from metrics.run.runner import run_missing
 
     spec = method_specs(("2D-S",), ("ideal",), tmp_path / "results")[0]
     scene = next(one_scene.iterdir())
     segmenter = Segmenter("toy", lambda rgb: rgb[..., 0] * 0, {"weights": "abc"})
     wrapped = with_predicted_masks([spec], segmenter)[0]
-    travelled = pickle.loads(pickle.dumps(wrapped.run))
-    result = travelled(scene, "ideal")
-    plain = spec.run(scene, "ideal")
-    assert result.config[CONFIG_KEY] == {"segmenter": "toy", "weights": "abc"}
-    assert wrapped.config[CONFIG_KEY] == result.config[CONFIG_KEY]
-    assert replace(result, config=plain.config, wall_time_s=0.0) == replace(
-        plain, wall_time_s=0.0)
+    travelled = pickle.loads(pickle.dumps(wrapped))
+    assert travelled.config == {**spec.config,
+                                CONFIG_KEY: {"segmenter": "toy", "weights": "abc"}}
+    assert replace(travelled.run(scene, "ideal"), wall_time_s=0.0) == replace(
+        spec.run(scene, "ideal"), wall_time_s=0.0)
+    (outcome,) = run_missing([scene], [travelled], tmp_path / "masks", log=lambda _: None)
+    assert read_result(outcome.path).config == travelled.config
 
 
 @pytest.mark.slow

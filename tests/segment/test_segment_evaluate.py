@@ -73,5 +73,5 @@ def test_the_cli_prints_per_building_and_family_rows(clean_scene, capsys, tmp_pa
     assert out[2].startswith("mean,imported,1,")
     assert (tmp_path / "iou.csv").read_text().splitlines()[1:] == out
     assert main(["--data", str(tmp_path / "none")]) == 2
-    assert "holds no scene folder" in capsys.readouterr().err
+    assert "does not exist" in capsys.readouterr().err
     assert main(["--data", str(clean_scene), "--max-frames", "0"]) == 2

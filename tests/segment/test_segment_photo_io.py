@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 
 from envelope.classes import NUM_CLASSES
-from segment.photo_io import read_photo_rgb
+from envelope.photo_io import read_photo_rgb
 from segment.predict import main
 from segment.segmenter import network_segmenter, segment_photo
 from segment.weights import DEFAULT_WEIGHTS

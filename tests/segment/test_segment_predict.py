@@ -29,6 +29,6 @@ def test_predict_copies_scenes_with_masks_and_refuses_bad_folders(clean_scene, t
     assert main(["--data", str(data), "--out", str(data), "--model", str(weights)]) == 2
     assert "holds the scenes themselves" in capsys.readouterr().err
     assert main(["--data", str(tmp_path / "none"), "--out", str(out)]) == 2
-    assert "holds no scene folder" in capsys.readouterr().err
+    assert "does not exist" in capsys.readouterr().err
     assert main(["--data", str(data), "--out", str(out), "--model", "nope"]) == 2
     assert "unknown segmenter 'nope'" in capsys.readouterr().err

@@ -16,12 +16,11 @@ import segment.train
 from dataset.presets import preset_recipes
 from envelope.classes import CLASS_NAMES
 from envelope.scenes.images import read_labels, read_rgb, write_labels, write_rgb
-from envelope.scenes.scene import read_scene
-from metrics.run.runner import find_scenes
+from envelope.scenes.scene import find_scene_folders, read_scene
 from segment.augment import AugmentConfig
 from segment.evaluate import masks_scene_iou
 from segment.network import UNetConfig
-from segment.scene_masks import RECORD_KEY, predicted_scene, scene_folders
+from segment.scene_masks import RECORD_KEY, predicted_scene
 from segment.segmenter import Segmenter, network_segmenter
 from segment.train import TrainConfig, main, train_segmenter
 from segment.training_data import (
@@ -184,7 +183,7 @@ def test_a_copy_a_killed_run_left_unfinished_is_no_scene(clean_scene, tmp_path):
     zeros = Segmenter("zeros", lambda rgb: np.zeros(rgb.shape[:2], np.uint8), {})
     done = predicted_scene(clean_scene, data, zeros, progress=False)
     shutil.copytree(done, data / f".{clean_scene.name}.x1y2.partial")
-    assert find_scenes(data) == scene_folders(data) == [done]
+    assert find_scene_folders(data) == find_scene_folders(data, with_images=True) == [done]
 
 
 @pytest.mark.parametrize("answer", ["shape", "dtype", "ids"])
@@ -215,5 +214,5 @@ def test_the_cli_explains_itself_and_refuses_bad_options(clean_scene, tmp_path, 
     assert main(["--data", str(clean_scene), "--out", str(tmp_path / "w.bin")]) == 2
     assert "must name a .pt file" in capsys.readouterr().err
     assert main(["--data", str(tmp_path / "none"), "--out", str(tmp_path / "w.pt")]) == 2
-    assert "holds no scene folder" in capsys.readouterr().err
+    assert "does not exist" in capsys.readouterr().err
     assert not (tmp_path / "w.pt").exists()

@@ -1,7 +1,7 @@
 """The BuildNet3D BlenderProc generator's (and dataparser's) layout as a source of scenes.
 
 ``python -m dataset.generate --buildnet3d PATH --out DIR`` reads PATH with
-:data:`BLENDERPROC_SOURCE` when it holds this layout (:func:`find_scenes`): a folder with
+:data:`BLENDERPROC_SOURCE` when it holds this layout (:func:`find_scene_folders`): a folder with
 ``meta_data.json`` and ``images/`` and ``semantic/`` (the dataparser) or ``semantics/`` (the
 generator) beside it, or a folder of such folders. One scene ``DIR/<folder name>`` per folder
 (:func:`import_scene` writes it). The facts and
@@ -59,7 +59,7 @@ BLENDER_PIXEL_CENTRE_SHIFT = 0.5
 """Added to BlenderProc's cx, cy: its pixel centres are at integers, ours at +0.5."""
 
 
-def find_scenes(path: str | Path) -> list[Path]:
+def find_scene_folders(path: str | Path) -> list[Path]:
     """The BlenderProc-layout folders at ``path``: itself, or its sub-folders (sorted)."""
     path = Path(path)
     if _is_scene(path):
@@ -77,7 +77,7 @@ def read_blenderproc(path: str | Path, options: NoOptions) -> tuple[SceneEntry, 
     ValueError
         ``path`` holds no such folder.
     """
-    scenes = find_scenes(path)
+    scenes = find_scene_folders(path)
     if not scenes:
         raise ValueError(f"{path} holds no BlenderProc-layout folder (meta_data.json with "
                          "images/ and semantic/ or semantics/ beside it)")
@@ -190,5 +190,5 @@ BLENDERPROC_SOURCE = Source(
     help="a BlenderProc generator or dataparser folder of the official BuildNet3D "
          "(meta_data.json with images/ and semantic/ or semantics/ beside it) or a folder of "
          "them: one scene per folder, as rendered",
-    detect=lambda path: bool(find_scenes(path)), read=read_blenderproc,
+    detect=lambda path: bool(find_scene_folders(path)), read=read_blenderproc,
 )

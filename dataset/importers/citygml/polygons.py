@@ -23,6 +23,7 @@ import shapely
 from shapely.geometry import MultiPolygon, Polygon
 
 from dataset.families.polygon_mesh import plane_basis
+from envelope.polygons import newell_vector
 
 PLANARITY_TOLERANCE_M = 0.01
 """A corner further than this from its polygon's plane makes the polygon non-planar (1 cm:
@@ -61,23 +62,13 @@ class PolygonTriangles:
     repaired: bool
 
 
-def newell_normal(ring_m: np.ndarray) -> np.ndarray:
-    """(3,) Newell normal of an (n, 3) ring: length = twice its (vector) area, direction by
-    the right-hand rule (counter-clockwise seen from where it points)."""
-    p = np.asarray(ring_m, dtype=np.float64)
-    q = np.roll(p, -1, axis=0)
-    return np.array([np.sum((p[:, 1] - q[:, 1]) * (p[:, 2] + q[:, 2])),
-                     np.sum((p[:, 2] - q[:, 2]) * (p[:, 0] + q[:, 0])),
-                     np.sum((p[:, 0] - q[:, 0]) * (p[:, 1] + q[:, 1]))])
-
-
 def triangulate_polygon(rings_m: tuple[np.ndarray, ...]) -> PolygonTriangles | None:
     """Triangulate one polygon (exterior ring, then holes; (n, 3) metres each).
 
     Returns None for a polygon without area (a ring along a line).
     """
     exterior = np.asarray(rings_m[0], dtype=np.float64)
-    n_vec = newell_normal(exterior)
+    n_vec = newell_vector(exterior)
     length = float(np.linalg.norm(n_vec))
     if length < 2 * MIN_AREA_M2:
         return None

@@ -19,11 +19,11 @@ from paths import FIXTURES
 from dataset.importers.citygml.convert import import_citygml
 from dataset.importers.citygml.files import citygml_files, citygml_stem
 from dataset.importers.citygml.grid_north import grid_north_deg
-from dataset.importers.citygml.polygons import newell_normal
 from dataset.importers.citygml.read import read_citygml
 from envelope.classes import NO_FACADE, SemanticClass
 from envelope.footprint import geojson_to_polygon
 from envelope.mesh import write_labelled_ply
+from envelope.polygons import newell_vector
 from envelope.truth import write_building
 
 FIXTURES = FIXTURES / "citygml"
@@ -42,9 +42,9 @@ def imported():
 
 def _vector_area_m2(rings) -> float:
     """A planar polygon's area from its rings' Newell normals (exterior minus holes)."""
-    n = newell_normal(rings[0])
+    n = newell_vector(rings[0])
     unit = n / np.linalg.norm(n)
-    return float(0.5 * (n @ unit) - sum(abs(0.5 * newell_normal(h) @ unit) for h in rings[1:]))
+    return float(0.5 * (n @ unit) - sum(abs(0.5 * newell_vector(h) @ unit) for h in rings[1:]))
 
 
 def test_reads_version_crs_and_kinds():

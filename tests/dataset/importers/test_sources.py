@@ -41,7 +41,7 @@ SMALL = GenerateConfig(resolution=32, views=4)
 
 def test_one_list_names_every_source_once_and_generate_offers_each():
     assert [s.name for s in SOURCES] == ["preset", "mesh", "ifc", "buildnet3d-blenderproc",
-                                         "buildnet3d-blender", "citygml"]
+                                         "buildnet3d-blender", "citygml", "photos"]
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf), pytest.raises(SystemExit):
         generate.main(["--help"])

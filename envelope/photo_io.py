@@ -1,11 +1,12 @@
-"""Reading a photo for the segmenter: any common file in, (H, W, 3) uint8 RGB out, or a
-clear error.
+"""Reading a photo (for the segmenter, and for the photos source of ``dataset.generate``): any
+common file in, (H, W, 3) uint8 RGB out, or a clear error.
 
 Photos are not renders: they come grey, 16-bit, CMYK, with an alpha channel or a
 palette, stored sideways with an EXIF orientation tag, or cut short by a failed copy.
 :func:`read_photo_rgb` gives every one that can be read an upright 8-bit RGB image:
 
-- the EXIF orientation is applied (the image as a viewer shows it);
+- the EXIF orientation is applied (the image as a viewer shows it), unless the caller
+  asks for the pixels as stored (``upright=False``: what COLMAP and nerfstudio read);
 - grey (``L``, ``LA``, ``1``), palette (``P``), ``RGBA``, ``CMYK`` (Adobe or not, as
   Pillow decodes it), ``YCbCr`` and ``LAB`` images are converted to RGB; an alpha
   channel is dropped;
@@ -26,8 +27,9 @@ from PIL import Image, ImageOps, UnidentifiedImageError
 _SIXTEEN_BIT_MODES = ("I;16", "I;16B", "I;16L", "I;16N", "I")
 
 
-def read_photo_rgb(path: str | Path) -> np.ndarray:
-    """The photo at ``path`` as the segmenter reads it: (H, W, 3) uint8 RGB, upright.
+def read_photo_rgb(path: str | Path, *, upright: bool = True) -> np.ndarray:
+    """The photo at ``path`` as the segmenter reads it: (H, W, 3) uint8 RGB, upright (its
+    EXIF orientation applied) unless ``upright`` is false.
 
     Raises
     ------
@@ -42,14 +44,14 @@ def read_photo_rgb(path: str | Path) -> np.ndarray:
             warnings.simplefilter("error", Image.DecompressionBombWarning)
             with Image.open(path) as img:
                 img.load()
-                upright = ImageOps.exif_transpose(img)
+                shown = ImageOps.exif_transpose(img) if upright else img.copy()
     except (UnidentifiedImageError, Image.DecompressionBombError,
             Image.DecompressionBombWarning) as exc:
         raise ValueError(f"{path}: not an image Pillow can read ({exc})") from exc
     except (OSError, SyntaxError, ValueError) as exc:
         raise ValueError(f"{path}: truncated or corrupt image ({exc}); copy the file again "
                          f"or re-save it") from exc
-    return pil_to_rgb(upright, str(path))
+    return pil_to_rgb(shown, str(path))
 
 
 def pil_to_rgb(img: Image.Image, what: str = "image") -> np.ndarray:

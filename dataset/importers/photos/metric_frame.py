@@ -1,0 +1,173 @@
+"""Metres and z up: the similarity that takes a structure-from-motion frame (any scale, any
+orientation) to the project's world (metres, z up, ground at z = 0), from what the user
+knows (docs/importing.md, section 9, says what is assumed).
+
+- **Up** from the cameras: photos are taken without roll (the EXIF orientation is applied
+  first, so every image is upright), so every camera's x axis (image right) is horizontal
+  and up is the direction most perpendicular to all of them: the eigenvector of the least
+  eigenvalue of sum x xᵀ, signed to agree with the cameras' mean y axis (image up). Exact
+  for any pitch when the photos face two directions or more. When they all face one way
+  (their x axes spread less than :data:`MIN_HEADING_SPREAD`), up is the cameras' mean y axis
+  made perpendicular to their x axes (exact only for level cameras).
+- **Scale** from one thing the user knows: the distance between two cameras (two photos'
+  names), or the building's height, taken as the span of the sparse points along up from
+  their :data:`GROUND_PERCENTILE` to their :data:`TOP_PERCENTILE`. Nothing known: refused.
+- **Where**: with sparse points, the ground (z = 0) at their :data:`GROUND_PERCENTILE` along
+  up and the origin above their median; without (a nerfstudio file), the input's origin.
+- **North** is unknown: the world's +y is the way the first photo looks (level).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+MIN_HEADING_SPREAD = 0.01
+"""The second-least eigenvalue of sum x xᵀ per camera below which the photos face one way
+(their x axes within about 6 degrees: sin² 6° ≈ 0.01)."""
+GROUND_PERCENTILE = 1.0
+TOP_PERCENTILE = 99.0
+"""The sparse points' percentiles along up taken for the ground and the building's top (a
+few stray points below the ground or above the roof change nothing)."""
+SCALE_OPTIONS = "--known-distance PHOTO_A PHOTO_B METRES or --known-height METRES"
+NO_SCALE = (f"photos carry no scale: say what you know, with {SCALE_OPTIONS} "
+            "(docs/importing.md, section 9)")
+
+
+@dataclass(frozen=True)
+class KnownDistance:
+    """The distance in metres between the cameras that took two photos (by file name)."""
+
+    photo_a: str
+    photo_b: str
+    metres: float
+
+
+@dataclass(frozen=True)
+class ScaleHint:
+    """What the user knows of the scale: one of a known distance between two cameras, or
+    the building's height in metres."""
+
+    known_distance: KnownDistance | None = None
+    known_height_m: float | None = None
+
+    def __post_init__(self) -> None:
+        given = (self.known_distance is not None) + (self.known_height_m is not None)
+        if given == 0:
+            raise ValueError(NO_SCALE)
+        if given == 2:
+            raise ValueError(f"give one scale, not both: {SCALE_OPTIONS}")
+        value = (self.known_distance.metres if self.known_distance is not None
+                 else self.known_height_m)
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"a known distance or height must be a positive number of "
+                             f"metres, got {value}")
+        if self.known_distance is not None and (self.known_distance.photo_a
+                                                == self.known_distance.photo_b):
+            raise ValueError("--known-distance needs two different photos")
+
+
+@dataclass(frozen=True)
+class Similarity:
+    """``world = scale * rotation @ p + translation_m`` for a point ``p`` of the input frame."""
+
+    scale: float
+    rotation: np.ndarray
+    translation_m: np.ndarray
+
+    def points(self, points: np.ndarray) -> np.ndarray:
+        """(N, 3) input-frame points in the world (m)."""
+        return self.scale * np.asarray(points, dtype=np.float64) @ self.rotation.T \
+            + self.translation_m
+
+    def pose(self, world_from_camera: np.ndarray) -> np.ndarray:
+        """(4, 4) a camera-to-world pose of the input frame in the world (still rigid)."""
+        pose = np.eye(4)
+        pose[:3, :3] = self.rotation @ np.asarray(world_from_camera)[:3, :3]
+        pose[:3, 3] = self.points(np.asarray(world_from_camera)[None, :3, 3])[0]
+        return pose
+
+
+def up_from_cameras(world_from_camera: np.ndarray) -> tuple[np.ndarray, str]:
+    """The unit up direction of the input frame from (N, 4, 4) OpenGL camera-to-world poses,
+    and how it was found (module docstring)."""
+    poses = np.asarray(world_from_camera, dtype=np.float64)
+    x_axes, y_axes = poses[:, :3, 0], poses[:, :3, 1]
+    values, vectors = np.linalg.eigh(x_axes.T @ x_axes / len(poses))
+    mean_y = y_axes.mean(axis=0)
+    if values[1] >= MIN_HEADING_SPREAD:
+        up, how = vectors[:, 0], "perpendicular to the cameras' x axes (photos without roll)"
+    else:
+        along = vectors[:, 2]
+        up = mean_y - (mean_y @ along) * along
+        how = ("the cameras' mean y axis (the photos all face one way: level cameras "
+               "assumed)")
+    up = up / np.linalg.norm(up)
+    return (up if up @ mean_y >= 0 else -up), how
+
+
+def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
+                      points: np.ndarray | None, hint: ScaleHint) -> tuple[Similarity, dict]:
+    """The similarity from the input frame to the world, and a record of what it assumed.
+
+    Parameters
+    ----------
+    world_from_camera : (N, 4, 4) OpenGL camera-to-world poses in the input frame
+    names : the N photos' names
+    points : (M, 3) sparse points in the input frame, or ``None``
+
+    Raises
+    ------
+    ValueError
+        A known distance names a photo that has no pose, or two cameras at one place; a
+        known height without sparse points.
+    """
+    poses = np.asarray(world_from_camera, dtype=np.float64)
+    up, up_how = up_from_cameras(poses)
+    right = poses[0, :3, 0] - (poses[0, :3, 0] @ up) * up
+    if np.linalg.norm(right) < 1e-6:
+        raise ValueError(f"the first photo ({names[0]}) looks straight up or down: put a "
+                         "photo taken level first")
+    right /= np.linalg.norm(right)
+    rotation = np.stack([right, np.cross(up, right), up])
+    scale, scale_how = _scale(poses, list(names), points, up, hint)
+    if points is None or len(points) == 0:
+        translation = np.zeros(3)
+        where = "the input's origin (no sparse points)"
+    else:
+        turned = scale * np.asarray(points, dtype=np.float64) @ rotation.T
+        translation = -np.array([*np.median(turned[:, :2], axis=0),
+                                 np.percentile(turned[:, 2], GROUND_PERCENTILE)])
+        where = (f"ground at the sparse points' {GROUND_PERCENTILE:g}th percentile along up, "
+                 "origin above their median")
+    record = {"up": up_how, "scale": scale_how, "origin": where,
+              "north": f"unknown: +y is the way the first photo ({names[0]}) looks"}
+    return Similarity(scale, rotation, translation), record
+
+
+def _scale(poses: np.ndarray, names: list[str], points: np.ndarray | None, up: np.ndarray,
+           hint: ScaleHint) -> tuple[float, str]:
+    known = hint.known_distance
+    if known is not None:
+        missing = [n for n in (known.photo_a, known.photo_b) if n not in names]
+        if missing:
+            raise ValueError(f"--known-distance names {', '.join(missing)}, which has no "
+                             f"camera pose (posed photos: {', '.join(names[:5])}"
+                             f"{' ...' if len(names) > 5 else ''})")
+        span = np.linalg.norm(poses[names.index(known.photo_a), :3, 3]
+                              - poses[names.index(known.photo_b), :3, 3])
+        if span <= 1e-9 * max(1.0, float(np.abs(poses[:, :3, 3]).max())):
+            raise ValueError(f"{known.photo_a} and {known.photo_b} were taken from one place: "
+                             "name two photos taken metres apart")
+        return known.metres / span, (f"known distance {known.metres:g} m between the cameras "
+                                     f"of {known.photo_a} and {known.photo_b}")
+    if points is None or len(points) == 0:
+        raise ValueError("--known-height needs the sparse points of structure from motion, "
+                         "which this input lacks: give --known-distance instead")
+    heights = np.asarray(points, dtype=np.float64) @ up
+    span = np.percentile(heights, TOP_PERCENTILE) - np.percentile(heights, GROUND_PERCENTILE)
+    return hint.known_height_m / span, (
+        f"known building height {hint.known_height_m:g} m over the sparse points' "
+        f"{GROUND_PERCENTILE:g}th to {TOP_PERCENTILE:g}th percentile along up")

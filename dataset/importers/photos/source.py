@@ -1,0 +1,161 @@
+"""The ``photos`` source: ``python -m dataset.generate --photos DIR --out OUT`` writes one
+scene ``OUT/<DIR's name>`` from a folder of photos, an existing COLMAP project or a
+nerfstudio ``transforms.json`` (docs/importing.md, section 9).
+
+The scene holds ``transforms.json`` (every posed photo a ``train`` frame, OpenGL
+camera-to-world poses in metres with z up, pinhole intrinsics) and ``images/`` (the photos
+undistorted, upright); no depth, no masks and no ``building.json``: photos carry no truth.
+Its ``photos`` record says how the poses, up, scale and origin were found and which photos
+got no pose. The scale is checked before anything runs (none given: refused); the scene is
+written into a temporary folder renamed when complete, so a failure leaves nothing.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+from tqdm import tqdm
+
+from dataset.importers.photos.existing import (
+    colmap_model_folder,
+    read_colmap_project,
+    read_nerfstudio,
+    transforms_file,
+)
+from dataset.importers.photos.metric_frame import NO_SCALE, ScaleHint, metric_similarity
+from dataset.importers.photos.photo_folder import PHOTO_SUFFIXES, Photo, list_photos
+from dataset.importers.photos.posed import (
+    PosedPhotos,
+    from_reconstruction,
+    sparse_points,
+    undistorted_rgb,
+)
+from dataset.importers.photos.sfm import SfmConfig, reconstruct
+from dataset.importers.source import SceneEntry, Source
+from envelope.photo_io import read_photo_rgb
+from envelope.protocols import TRAIN_PROTOCOL
+from envelope.scene_record import Frame, Scene
+from envelope.scenes.scene import write_transforms
+
+JPEG_QUALITY = 95
+"""Undistorted JPEG photos are written again as JPEG at this quality (PNG stays PNG)."""
+RECORD_KEY = "photos"
+
+
+@dataclass(frozen=True)
+class PhotosOptions:
+    """What the photos source reads: the scale the user knows (``None``: refused, with the
+    options to give) and the structure-from-motion settings."""
+
+    scale: ScaleHint | None = None
+    sfm: SfmConfig = SfmConfig()
+    progress: bool = True
+
+
+def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, ...]:
+    """One scene entry for the photos at ``path``, named by the folder; the photos and the
+    scale are checked now, structure from motion runs when the scene is written.
+
+    Raises
+    ------
+    ValueError
+        No scale given, or (a folder of photos) as
+        :func:`dataset.importers.photos.photo_folder.list_photos`.
+    """
+    path = Path(path)
+    if options.scale is None:
+        raise ValueError(NO_SCALE)
+    if colmap_model_folder(path) is not None:
+        return (SceneEntry(path.resolve().name, partial(_write, read_colmap_project, path,
+                                                        options)),)
+    if transforms_file(path) is not None:
+        folder = path if path.is_dir() else path.parent
+        return (SceneEntry(folder.resolve().name, partial(_write, read_nerfstudio, path,
+                                                          options)),)
+    photos = list_photos(path)
+    known = options.scale.known_distance
+    missing = [] if known is None else [n for n in (known.photo_a, known.photo_b)
+                                        if n not in {p.name for p in photos}]
+    if missing:
+        raise ValueError(f"--known-distance names {', '.join(missing)}, which is not a photo "
+                         f"of {path} (give the photos' file names, e.g. {photos[0].name})")
+    return (SceneEntry(path.resolve().name, partial(_write, partial(_structure_from_motion,
+                                                                    photos, options.sfm),
+                                                    path, options)),)
+
+
+def detect_photos(path: str | Path) -> bool:
+    """Whether ``path`` is a COLMAP project, a nerfstudio ``transforms.json`` or a folder
+    holding photos (cheap; never raises)."""
+    try:
+        path = Path(path)
+        return (colmap_model_folder(path) is not None or transforms_file(path) is not None
+                or (path.is_dir() and any(p.suffix.lower() in PHOTO_SUFFIXES
+                                          for p in path.iterdir())))
+    except OSError:
+        return False
+
+
+def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
+                           path: Path) -> PosedPhotos:
+    with tempfile.TemporaryDirectory(prefix="photos-sfm-") as work:
+        upright = Path(work) / "upright"
+        upright.mkdir()
+        for photo in photos:
+            # Every photo is decoded here, before COLMAP sees it: a broken file stops the run.
+            Image.fromarray(read_photo_rgb(photo.path)).save(upright / photo.name,
+                                                             format="PNG", compress_level=1)
+        model = reconstruct(photos, upright, Path(work), config)
+        posed = from_reconstruction(model, upright, upright=True)
+        # The upright copies go with the temporary folder: point back at the photos.
+        posed = tuple(replace(p, path=path / p.name) for p in posed)
+        placed = {p.name for p in posed}
+        return PosedPhotos(posed, sparse_points(model),
+                           tuple(p.name for p in photos if p.name not in placed),
+                           {"input": "photos", "structure_from_motion": "COLMAP (pycolmap) "
+                            "incremental mapping, SIFT, exhaustive matching, CPU",
+                            "mean_reprojection_error_px":
+                                round(float(model.compute_mean_reprojection_error()), 4)})
+
+
+def _write(read: Callable[[Path], PosedPhotos], path: Path, options: PhotosOptions,
+           out_dir: Path) -> Scene:
+    """Pose the photos of ``path`` with ``read``, take them to metres and z up, and write
+    the scene into ``out_dir``."""
+    posed = read(path)
+    names = [p.name for p in posed.photos]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{path}: two images share a file name; rename them")
+    similarity, frame_record = metric_similarity(
+        np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
+        options.scale)
+    (out_dir / "images").mkdir()
+    frames = []
+    for photo in tqdm(posed.photos, desc="photos", unit="photo", disable=not options.progress):
+        rgb, intrinsics = undistorted_rgb(photo)
+        relative = f"images/{photo.name}"
+        jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
+        Image.fromarray(rgb).save(out_dir / relative, **(
+            {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
+        frames.append(Frame(relative, similarity.pose(photo.world_from_camera), intrinsics,
+                            TRAIN_PROTOCOL))
+    record = {**posed.record, **frame_record, "posed": len(frames),
+              "unposed": list(posed.unposed), "scale_factor": similarity.scale}
+    scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
+    write_transforms(out_dir, scene)
+    return scene
+
+
+PHOTOS_SOURCE = Source(
+    name="photos", flag="--photos",
+    help="a folder of JPEG or PNG photos of one building (poses from structure from motion), "
+         "a COLMAP project (sparse/0 and images/) or a nerfstudio transforms.json; needs "
+         "--known-distance or --known-height for the scale",
+    detect=detect_photos, read=read_photos, options_type=PhotosOptions,
+)
