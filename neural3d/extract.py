@@ -57,9 +57,11 @@ from neural3d.extraction.meshing import (
     extract_mesh,
 )
 from neural3d.extraction.straight_walls import straighten_footprint
-from neural3d.method import METHOD_NEURAL3D
 
 PROTOCOL = TRAIN_PROTOCOL
+
+METHOD_NAME = "neural3d"
+"""The method's name, in its result files and in :data:`neural3d.method.METHOD_NEURAL3D`."""
 
 
 def field_sdf_fn(trained, device: torch.device, chunk_points: int) -> SdfFn:
@@ -190,7 +192,7 @@ def measure_mesh(trained, mesh: SemanticMesh, config: ExtractConfig, *, device: 
         footprint = None
         warnings.append(f"no footprint: {exc}")
     return MethodResult(
-        scene=trained.scene_name, method=METHOD_NEURAL3D.name, protocol=PROTOCOL, wwr=m.wwr,
+        scene=trained.scene_name, method=METHOD_NAME, protocol=PROTOCOL, wwr=m.wwr,
         window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
         footprint=footprint, config=asdict(config), code_version=code_version(),
         facade_identity="geometry",

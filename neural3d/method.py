@@ -23,6 +23,7 @@ from envelope.protocols import TRAIN_PROTOCOL
 from envelope.results import MethodResult
 from envelope.scene_record import scene_name
 from neural3d.config import TrainConfig, config_to_dict, preset_config
+from neural3d.extract import METHOD_NAME, measure_run
 from neural3d.extraction.extract_config import ExtractConfig
 
 RUNS_FOLDER = "neural3d_runs"  # under the results folder: one run folder per scene
@@ -175,7 +176,6 @@ def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
     import torch
 
     # isort sees a module as first-party only once its file exists: keep this block as is.
-    from neural3d.extract import measure_run  # noqa: I001
     from neural3d.field.checkpoint import CHECKPOINT_NAME, read_checkpoint
     from neural3d.train import train
     from neural3d.training.run_folder import prior_run, training_provenance
@@ -216,7 +216,7 @@ def reserve(budget: Neural3dBudget) -> tuple[float, float]:
 
 
 METHOD_NEURAL3D = Method(
-    name="neural3d", inputs=("rgb", "semantics", "depth", "poses"), protocols=(TRAIN_PROTOCOL,),
+    name=METHOD_NAME, inputs=("rgb", "semantics", "depth", "poses"), protocols=(TRAIN_PROTOCOL,),
     config_type=Neural3dBudget, run=run_neural3d, has_footprint=True,
     packages=("neural3d",), libraries=LIBRARIES,
     description="semantic neural SDF trained on the orbit views; WWR, areas and footprint "

@@ -208,7 +208,7 @@ def test_sigint_to_the_driver_cancels_tasks_and_leaves_only_whole_results(
             finished.touch()
         return replace(quick.run(scene_dir, protocol), method="slow")
 
-    slow = replace(quick, name="slow", run=slow_run)
+    slow = replace(quick, method=replace(quick.method, name="slow"), run=slow_run)
     others = [results / f"{s.name}__{m}__ideal.json" for s in scenes for m in ("2D-S", "slow")
               if (s.name, m) != (slow_scene, "slow")]
 
