@@ -1,16 +1,10 @@
 """Comparisons on a segmenter's masks (``python -m metrics.compare --masks predicted[:MODEL]``).
 
-Every scene is copied once into ``<data>-masks/<key>/<scene>`` with the semantic image
-of each view the methods read replaced by the segmenter's prediction from its RGB
-(:func:`segment.scene_masks.predicted_scene`: cached by provenance, the truth and
-every other file hard links to the original; views no method reads are left out, see
-:func:`splits_read`). The methods run on the copies
-unchanged; their results go to ``<results>/masks/<key>`` and carry the segmenter in
-their config under ``masks``; the truth stays the exact one. The usual comparison on
-the exact masks runs too (reusing its stored results), and ``<out>-masks-<key>``
-gets, beside the usual outputs, ``exact_vs_predicted`` (CSV, Markdown, LaTeX): per
-building, the segmenter's window IoU and each method's WWR, window and facade error
-on exact and on predicted masks, and per family the means.
+The comparison on the exact masks runs (reusing its stored results), then the same on the
+scene copies with the segmenter's masks (:mod:`metrics.run.predicted_masks`); the truth stays
+the exact one. ``<out>-masks-<key>`` gets, beside the usual outputs, ``exact_vs_predicted``
+(CSV, Markdown, LaTeX): per building, the segmenter's window IoU and each method's WWR,
+window and facade error on exact and on predicted masks, and per family the means.
 """
 
 from __future__ import annotations
