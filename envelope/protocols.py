@@ -24,9 +24,9 @@ STREET_PROTOCOL: Protocol = "street"
 OWN_FACADE_PROTOCOLS: tuple[Protocol, ...] = (TRAIN_PROTOCOL, STREET_PROTOCOL)
 """Protocols of posed views without facade ids, on which the 2D methods find the facades
 themselves (:mod:`baselines.own_facades`)."""
-SELECTABLE_PROTOCOLS: tuple[Protocol, ...] = (*VIEW_PROTOCOLS, STREET_PROTOCOL)
-"""The protocols a comparison runs a method on only when asked (``--views``); the others
-(``train``) always, for a method that declares them."""
+DEFAULT_PROTOCOLS: tuple[Protocol, ...] = (*VIEW_PROTOCOLS, TRAIN_PROTOCOL)
+"""The protocols a comparison runs when not told otherwise (``--views``): the paper's ideal,
+multi and orbit views. A method runs on those of them it declares."""
 Split = Literal[Protocol, "eval"]
 """A scene frame's split: a protocol's views, or ``eval``: held-out orbit views no method runs
 on (neural3d evaluates its renders on them)."""

@@ -35,7 +35,6 @@ from envelope.classes import NUM_CLASSES, class_id_from_name
 from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, run_cli
 from envelope.device import resolve_device
 from envelope.footprint import polygon_to_geojson
-from envelope.protocols import TRAIN_PROTOCOL
 from envelope.resources import check_mesh_resources
 from envelope.results import FacadeEstimate, MethodResult, code_version, write_result
 from envelope.semantic_ply import write_semantic_ply
@@ -57,8 +56,6 @@ from neural3d.extraction.meshing import (
     extract_mesh,
 )
 from neural3d.extraction.straight_walls import straighten_footprint
-
-PROTOCOL = TRAIN_PROTOCOL
 
 METHOD_NAME = "neural3d"
 """The method's name, in its result files and in :data:`neural3d.method.METHOD_NEURAL3D`."""
@@ -146,7 +143,8 @@ def measure_field(
 
     Returns
     -------
-    result : MethodResult (method "neural3d", protocol "train"); a footprint that
+    result : MethodResult (method "neural3d", protocol: the split the field was trained on,
+        ``trained.split``); a footprint that
         cannot be found becomes ``None`` with a warning.
     mesh : SemanticMesh
 
@@ -192,7 +190,7 @@ def measure_mesh(trained, mesh: SemanticMesh, config: ExtractConfig, *, device: 
         footprint = None
         warnings.append(f"no footprint: {exc}")
     return MethodResult(
-        scene=trained.scene_name, method=METHOD_NAME, protocol=PROTOCOL, wwr=m.wwr,
+        scene=trained.scene_name, method=METHOD_NAME, protocol=trained.split, wwr=m.wwr,
         window_area_m2=m.window_area_m2, facade_area_m2=m.facade_area_m2, facades=facades,
         footprint=footprint, config=asdict(config), code_version=code_version(),
         facade_identity="geometry",

@@ -19,7 +19,7 @@ from typing import Any, Literal
 from envelope.method import Method
 from envelope.method_input import MethodInput, require_method_input
 from envelope.method_options import Option
-from envelope.protocols import TRAIN_PROTOCOL
+from envelope.protocols import STREET_PROTOCOL, TRAIN_PROTOCOL
 from envelope.results import MethodResult
 from envelope.scene_record import scene_name
 from neural3d.config import TrainConfig, config_to_dict, preset_config
@@ -157,10 +157,19 @@ def record_config(budget: Neural3dBudget) -> dict[str, Any]:
     }
 
 
+def run_folder(artefacts_dir: Path, scene: str, protocol: str) -> Path:
+    """Where a training on ``protocol``'s frames of ``scene`` lives: ``<artefacts>/<scene>``
+    for the orbit (``train``), ``<artefacts>/<protocol>/<scene>`` for another capture."""
+    if protocol == TRAIN_PROTOCOL:
+        return artefacts_dir / scene
+    return artefacts_dir / protocol / scene
+
+
 def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
                  artefacts_dir: Path) -> MethodResult:
-    """Train for ``budget.steps`` steps (``neural3d.train``, on ``scene`` as read here) into
-    ``artefacts_dir / <scene>``, then mesh and measure it (``neural3d.extract``) into its
+    """Train for ``budget.steps`` steps (``neural3d.train``, on ``scene`` as read here, on the
+    frames of ``protocol``: ``train``, the orbit, or ``street``) into
+    :func:`run_folder`, then mesh and measure it (``neural3d.extract``) into its
     ``extract`` folder; the result is returned, not written (the runner writes it).
 
     A run folder already there with the same training provenance
@@ -183,11 +192,11 @@ def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
     config = train_config(budget)
     torch.set_num_threads(budget.threads)
     device = torch.device(budget.device)
-    run_dir = Path(artefacts_dir) / scene_name(scene.root)
-    prior = prior_run(run_dir, training_provenance(scene.root, config, device),
+    run_dir = run_folder(Path(artefacts_dir), scene_name(scene.root), protocol)
+    prior = prior_run(run_dir, training_provenance(scene.root, config, device, split=protocol),
                       config.iterations)
     if prior != "finished":
-        run_dir = train(scene, config, artefacts_dir, device=device,
+        run_dir = train(scene, config, run_dir.parent, device=device, split=protocol,
                         resume=prior == "partial", max_seconds=budget.max_minutes * 60.0)
     state = read_checkpoint(run_dir / CHECKPOINT_NAME, torch.device("cpu"))
     steps = int(state["step"])
@@ -216,11 +225,12 @@ def reserve(budget: Neural3dBudget) -> tuple[float, float]:
 
 
 METHOD_NEURAL3D = Method(
-    name=METHOD_NAME, inputs=("rgb", "semantics", "depth", "poses"), protocols=(TRAIN_PROTOCOL,),
+    name=METHOD_NAME, inputs=("rgb", "semantics", "depth", "poses"),
+    protocols=(TRAIN_PROTOCOL, STREET_PROTOCOL),
     config_type=Neural3dBudget, run=run_neural3d, has_footprint=True,
     packages=("neural3d",), libraries=LIBRARIES,
-    description="semantic neural SDF trained on the orbit views; WWR, areas and footprint "
-                "measured on its mesh (cpu or gpu: --device)",
+    description="semantic neural SDF trained on the orbit (train) or street views; WWR, areas "
+                "and footprint measured on its mesh (cpu or gpu: --device)",
     record_config=record_config, reserve=reserve, artefacts=RUNS_FOLDER,
     mesh_file=f"{EXTRACT_FOLDER}/mesh.ply", heavy=True,
     options=OPTIONS, short_run=SHORT_RUN, check_config=check_budget, paper_name="BuildNet3D",

@@ -26,7 +26,7 @@ from envelope.cli_errors import add_debug_flag, check_output_folder, exit_cli, r
 from envelope.device import resolve_device
 from envelope.method_input import MethodInput, require_method_input
 from envelope.progress import progress_bar
-from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
+from envelope.protocols import EVAL_SPLIT, OWN_FACADE_PROTOCOLS, TRAIN_PROTOCOL, Split
 from envelope.resources import check_training_resources
 from envelope.scene_record import scene_name
 from envelope.scenes.scene import read_method_input
@@ -63,8 +63,9 @@ Callback = Callable[[int, TrainedField], "bool | None"]
 
 def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: torch.device,
           resume: bool = False, max_seconds: float | None = None,
-          callback: Callback | None = None) -> Path:
-    """Train on the scene's ``train`` frames; returns the run folder ``out_dir/<scene name>``.
+          callback: Callback | None = None, split: Split = TRAIN_PROTOCOL) -> Path:
+    """Train on the scene's ``split`` frames (``train``: the orbit views; ``street``: a street
+    capture); returns the run folder ``out_dir/<scene name>``.
 
     ``scene`` is the scene as a method reads it (no truth:
     :func:`envelope.scenes.scene.read_method_input`), read once by the caller; its ``root``
@@ -78,8 +79,9 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
     Raises
     ------
     ValueError
-        On an unusable scene (no train frames, mismatched image sizes, ...), an
-        unavailable device, or ``resume`` without a checkpoint or with another config.
+        On an unusable scene (no ``split`` frames, mismatched image sizes, ...), an
+        unavailable device, or ``resume`` without a checkpoint or with another config or
+        split.
     """
     device = resolve_device(device)
     scene = require_method_input(scene, "neural3d.train")
@@ -89,15 +91,15 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
     check_training_resources(sum(
         round(f.intrinsics.width * config.image_scale) * round(f.intrinsics.height
                                                                * config.image_scale)
-        for f in scene.frames_in(TRAIN_PROTOCOL)))
-    frames = load_frames(scene, TRAIN_PROTOCOL, image_scale=config.image_scale,
+        for f in scene.frames_in(split)))
+    frames = load_frames(scene, split, image_scale=config.image_scale,
                          with_depth=config.depth_loss)
     if resume:
-        norm = check_resumable(run_dir, config)
+        norm = check_resumable(run_dir, config, split=split)
     else:
         norm = scene_normalisation(frames, bg, margin=config.scene_box_margin)
         start_run_folder(run_dir, scene_dir, CLASS_NAMES, bg, norm, config, device,
-                         len(frames))
+                         len(frames), split=split)
     pixels = frames_to_pixels(frames, norm, device)
     eval_pixels = None
     eval_frames = scene.frames_in(EVAL_SPLIT)
@@ -186,7 +188,7 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
                 if callback is not None:
                     measured.eval()
                     answer = callback(step, TrainedField(measured, norm, scene_dir=scene_dir,
-                                                         class_names=classes))
+                                                         class_names=classes, split=split))
                     measured.train()
                     stop = stop or answer is True
             if stop:
@@ -220,11 +222,14 @@ def _sigterm_as_interrupt():
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m neural3d.train",
-        description="Train the semantic neural SDF on a scene's train frames (RGB + semantic "
-                    "masks + poses). Writes <out>/<scene name>/ with config.json, run.json, "
-                    "checkpoint.pt, log.csv and eval.json.")
+        description="Train the semantic neural SDF on a scene's train (orbit) or street frames "
+                    "(RGB + semantic masks + poses). Writes <out>/<scene name>/ with "
+                    "config.json, run.json, checkpoint.pt, log.csv and eval.json.")
     parser.add_argument("--scene", type=Path, required=True, help="scene folder "
-                        "(transforms.json with split='train' frames)")
+                        "(transforms.json with frames of the --split)")
+    parser.add_argument("--split", choices=OWN_FACADE_PROTOCOLS, default=TRAIN_PROTOCOL,
+                        help="the frames to train on: train (the orbit views, default) or "
+                             "street (a street capture: scenes made with --street)")
     parser.add_argument("--preset", choices=PRESETS, default=None,
                         help="paper (8x256 MLP, GPU), fast (grid, default) or tiny (tests)")
     parser.add_argument("--out", type=Path, default=Path("runs/neural3d"),
@@ -265,7 +270,7 @@ def main(argv: list[str] | None = None) -> int:
         max_s = None if args.max_minutes is None else 60.0 * args.max_minutes
         device = resolve_device(args.device)
         print(train(read_method_input(args.scene), config, args.out, device=device,
-                    resume=args.resume, max_seconds=max_s))
+                    resume=args.resume, max_seconds=max_s, split=args.split))
         return 0
 
     def interrupted() -> str:

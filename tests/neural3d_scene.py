@@ -19,8 +19,10 @@ from envelope.truth import Building
 
 
 def write_ring_scene(building: Building, root: Path, *, size_px: int = 40, n_train: int = 24,
-                     n_eval: int = 2, distance_m: float = 40.0, fov_deg: float = 50.0) -> Path:
-    """Render ``n_train + n_eval`` views of ``building`` into a scene folder at ``root``."""
+                     n_eval: int = 2, distance_m: float = 40.0, fov_deg: float = 50.0,
+                     split: str = "train") -> Path:
+    """Render ``n_train + n_eval`` views of ``building`` into a scene folder at ``root``; the
+    training views go to ``split`` (``train``: the orbit, or ``street``)."""
     root = Path(root)
     lo, hi = building.mesh.vertices_m.min(0), building.mesh.vertices_m.max(0)
     target = (lo + hi) / 2
@@ -43,7 +45,7 @@ def write_ring_scene(building: Building, root: Path, *, size_px: int = 40, n_tra
         write_depth_m(root / "depth" / name, gt.depth_z_m, 0.001)
         frames.append(Frame(
             file_path=f"images/{name}", world_from_camera=pose, intrinsics=k,
-            split="eval" if i % (n // max(n_eval, 1)) == 1 and n_eval else "train",
+            split="eval" if i % (n // max(n_eval, 1)) == 1 and n_eval else split,
             semantic_file_path=f"semantics/{name}", depth_file_path=f"depth/{name}",
         ))
     write_transforms(root, Scene(root=root, frames=tuple(frames)))

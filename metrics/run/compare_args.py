@@ -18,7 +18,7 @@ from dataset.degrade.spec import DEGRADATIONS, DegradeSpec, parse_specs
 from envelope.cli_errors import add_debug_flag
 from envelope.executors.ray_tasks import add_executor_arguments
 from envelope.method import Method
-from envelope.protocols import VIEW_PROTOCOLS
+from envelope.protocols import DEFAULT_PROTOCOLS
 from metrics.run.method_args import add_method_options, method_configs
 from metrics.run.methods import METHODS
 from metrics.run.predicted_masks import MasksRequest, parse_masks
@@ -63,13 +63,13 @@ def parse_compare_args(argv: Sequence[str] | None,
                         "(default: the built-in tiny benchmark)")
     parser.add_argument("--methods", default=",".join(METHODS),
                         help=f"comma-separated methods (default: {','.join(METHODS)})")
-    parser.add_argument("--views", default=",".join(VIEW_PROTOCOLS),
-                        help="comma-separated view protocols of the methods that run on them: "
-                        "ideal, multi (aimed at the truth's facades, as in the paper), street "
-                        "(a street capture placed without the truth, scenes made with "
-                        f"--street; the 2D methods find their own facades) (default: "
-                        f"{','.join(VIEW_PROTOCOLS)}); a method on the orbit views always uses "
-                        "those")
+    parser.add_argument("--views", default=",".join(DEFAULT_PROTOCOLS),
+                        help="comma-separated view protocols; each method runs on those it "
+                        "declares (--list-methods): ideal, multi (views aimed at the truth's "
+                        "facades, as in the paper), train (the orbit views), street (a street "
+                        "capture placed without the truth, scenes made with --street); on train "
+                        "and street every method finds its own facades (default: "
+                        f"{','.join(DEFAULT_PROTOCOLS)})")
     parser.add_argument("--results", type=Path,
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from envelope.method import BUILT_IN, Method, built_in_method, installed_methods
-from envelope.protocols import SELECTABLE_PROTOCOLS
+from envelope.protocols import PROTOCOLS
 from metrics.run.runner import MethodSpec, config_seed, folder_spec, run_on_folder
 
 METHODS: tuple[str, ...] = tuple(BUILT_IN)
@@ -65,12 +65,12 @@ def spec_from_method(method: Method, views: tuple[str, ...], results_dir: Path,
                      config: Any = None) -> MethodSpec:
     """The spec of ``method`` run with ``config`` (``None``: its config type's default).
 
-    It runs on the protocols it declares: of the selectable ones (ideal, multi, street), those
-    in ``views``; others (``train``) always. A method with an ``artefacts`` folder
+    It runs on the protocols it declares that ``views`` names (ideal, multi, train: the
+    orbit views, street). A method with an ``artefacts`` folder
     keeps it under ``results_dir`` (a seed other than 0 in ``seed<k>/`` below it).
     """
     config = method.config_type() if config is None else config
-    protocols = tuple(p for p in method.protocols if p not in SELECTABLE_PROTOCOLS or p in views)
+    protocols = tuple(p for p in method.protocols if p in views)
     seed = config_seed(config)
     artefacts_dir = results_dir / method.artefacts if method.artefacts else None
     if artefacts_dir is not None and seed:
@@ -104,9 +104,8 @@ def _check_names(names: tuple[str, ...], views: tuple[str, ...]) -> dict[str, Me
     if not names:
         raise ValueError(f"no method given; choose from {', '.join(METHODS)}")
     for view in views:
-        if view not in SELECTABLE_PROTOCOLS:
-            raise ValueError(f"unknown views {view!r}; choose from "
-                             f"{', '.join(SELECTABLE_PROTOCOLS)}")
+        if view not in PROTOCOLS:
+            raise ValueError(f"unknown views {view!r}; choose from {', '.join(PROTOCOLS)}")
     plugins = installed_methods() if any(n not in METHODS for n in names) else {}
     for name in names:
         if name not in METHODS and name not in plugins:

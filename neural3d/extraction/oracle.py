@@ -32,6 +32,7 @@ from scipy.spatial import cKDTree
 
 from envelope.classes import CLASS_NAMES, NUM_CLASSES
 from envelope.mesh import LabelledMesh, triangle_areas_m2
+from envelope.protocols import TRAIN_PROTOCOL
 
 CANDIDATE_FACES = 8  # nearest surface samples whose triangles are tested exactly
 SAMPLES_PER_VOXEL = 3  # surface samples per voxel length
@@ -61,6 +62,7 @@ class OracleField:
 
     class_names = CLASS_NAMES
     device = torch.device("cpu")
+    split = TRAIN_PROTOCOL  # its results stand in for a field trained on the orbit
 
     def __init__(self, mesh: LabelledMesh, name: str, *, voxel_m: float,
                  box_min_m: np.ndarray, box_max_m: np.ndarray):

@@ -10,6 +10,7 @@ import torch
 from torch import Tensor
 
 from envelope.device import resolve_device
+from envelope.protocols import SPLITS, TRAIN_PROTOCOL, Split
 from envelope.scene_record import scene_name
 from neural3d.config import FieldConfig, config_from_dict
 from neural3d.field.checkpoint import read_checkpoint, snapshot_path, snapshot_steps
@@ -27,12 +28,13 @@ class TrainedField:
     """
 
     def __init__(self, field: SemanticSDF, normalisation: Normalisation, *, scene_dir: Path,
-                 class_names: tuple[str, ...]) -> None:
+                 class_names: tuple[str, ...], split: Split = TRAIN_PROTOCOL) -> None:
         self.field = field
         self.normalisation = normalisation
         self.scene_dir = Path(scene_dir)
         self.scene_name = scene_name(self.scene_dir)
         self.class_names = tuple(class_names)
+        self.split = split  # the frames it was trained on: the protocol of its results
         self.box_min_m = np.asarray(normalisation.box_min_m, dtype=np.float64)
         self.box_max_m = np.asarray(normalisation.box_max_m, dtype=np.float64)
 
@@ -118,6 +120,9 @@ def load_trained_field(run_dir: Path, *, device: torch.device,
         norm = Normalisation.from_json_dict(run["normalisation"])
         class_names = tuple(str(c) for c in run["class_names"])
         scene_dir = Path(run["scene_dir"])
+        split = run.get("split", TRAIN_PROTOCOL)  # runs before 2026-11-29 trained on train
+        if split not in SPLITS:
+            raise ValueError(f"unknown split {split!r}")
     except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
             ValueError) as exc:
         raise ValueError(f"{run_dir} holds a damaged config.json or run.json ({exc}); train "
@@ -131,7 +136,7 @@ def load_trained_field(run_dir: Path, *, device: torch.device,
     field.load_state_dict(state.get("ema", state["field"]))  # the averaged weights if any
     field.set_step(int(state["step"]))
     field.eval()
-    return TrainedField(field, norm, scene_dir=scene_dir, class_names=class_names)
+    return TrainedField(field, norm, scene_dir=scene_dir, class_names=class_names, split=split)
 
 
 def build_field(model_config: FieldConfig, num_classes: int, norm: Normalisation) -> SemanticSDF:

@@ -16,6 +16,7 @@ from typing import Literal
 import torch
 
 from envelope.atomic import write_json_atomic, write_text_atomic
+from envelope.protocols import TRAIN_PROTOCOL, Split
 from envelope.provenance import (
     Provenance,
     file_fingerprint,
@@ -42,14 +43,14 @@ LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "
               "inv_s", "lr")
 
 
-def training_provenance(scene_dir: Path, config: TrainConfig,
-                        device: torch.device) -> Provenance:
-    """What a training depends on: its config, device and torch thread count (reductions
-    depend on them), the source of :data:`TRAINING_CODE`, the scene's ``transforms.json``
-    and the versions of :data:`TRAINING_LIBRARIES`."""
+def training_provenance(scene_dir: Path, config: TrainConfig, device: torch.device, *,
+                        split: Split = TRAIN_PROTOCOL) -> Provenance:
+    """What a training depends on: its config, the frames it reads (``split``), device and
+    torch thread count (reductions depend on them), the source of :data:`TRAINING_CODE`, the
+    scene's ``transforms.json`` and the versions of :data:`TRAINING_LIBRARIES`."""
     transforms = Path(scene_dir) / "transforms.json"
     return make_provenance(
-        {"train": config_to_dict(config), "device": str(device),
+        {"train": config_to_dict(config), "split": split, "device": str(device),
          "threads": torch.get_num_threads()},
         modules=TRAINING_CODE,
         inputs={"scene": file_fingerprint(transforms) if transforms.is_file() else "absent"},
@@ -77,10 +78,10 @@ def prior_run(run_dir: Path, expected: Provenance, iterations: int) -> PriorRun:
 
 def start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], bg: int,
                      norm: Normalisation, config: TrainConfig, device: torch.device,
-                     n_train: int) -> None:
+                     n_train: int, *, split: Split = TRAIN_PROTOCOL) -> None:
     """Start ``run_dir`` afresh: remove a previous run's checkpoint and logs, write the config
-    and ``run.json`` (scene, classes, background class, normalisation, device, versions and
-    the :func:`training_provenance`)."""
+    and ``run.json`` (scene, the split trained on, classes, background class, normalisation,
+    device, versions and the :func:`training_provenance`)."""
     run_dir.mkdir(parents=True, exist_ok=True)
     for stale in (CHECKPOINT_NAME, "log.csv", "eval.json"):
         (run_dir / stale).unlink(missing_ok=True)
@@ -91,14 +92,16 @@ def start_run_folder(run_dir: Path, scene_dir: Path, classes: tuple[str, ...], b
         "class_names": list(classes), "background_class": bg,
         "normalisation": norm.to_json_dict(), "device": str(device),
         "code_version": code_version(), "torch_version": torch.__version__,
-        "train_frames": n_train,
-        "provenance": training_provenance(scene_dir, config, device).to_json_dict(),
+        "split": split, "train_frames": n_train,
+        "provenance": training_provenance(scene_dir, config, device,
+                                          split=split).to_json_dict(),
     })
 
 
-def check_resumable(run_dir: Path, config: TrainConfig) -> Normalisation:
-    """The normalisation of a run that can resume with ``config``; ValueError with the reason
-    (a file missing, another config, a damaged ``run.json``) otherwise."""
+def check_resumable(run_dir: Path, config: TrainConfig, *,
+                    split: Split = TRAIN_PROTOCOL) -> Normalisation:
+    """The normalisation of a run that can resume with ``config`` on ``split``; ValueError with
+    the reason (a file missing, another config or split, a damaged ``run.json``) otherwise."""
     for name in ("config.json", "run.json", CHECKPOINT_NAME):
         if not (run_dir / name).is_file():
             raise ValueError(f"cannot resume: {run_dir / name} does not exist (train without "
@@ -109,11 +112,16 @@ def check_resumable(run_dir: Path, config: TrainConfig) -> Normalisation:
                          "with the config in its config.json")
     try:
         run = json.loads((run_dir / "run.json").read_text())
-        return Normalisation.from_json_dict(run["normalisation"])
+        norm = Normalisation.from_json_dict(run["normalisation"])
+        trained_split = run.get("split", TRAIN_PROTOCOL)
     except (json.JSONDecodeError, UnicodeDecodeError, TypeError, KeyError, AttributeError,
             ValueError) as exc:
         raise ValueError(f"cannot resume: {run_dir / 'run.json'} is damaged ({exc}); train "
                          "again without --resume") from exc
+    if trained_split != split:
+        raise ValueError(f"cannot resume: {run_dir} was trained on the {trained_split!r} frames, "
+                         f"not {split!r}; resume with --split {trained_split}")
+    return norm
 
 
 def write_log(run_dir: Path, rows: list[dict]) -> None:

@@ -24,7 +24,7 @@ def compared(tmp_path_factory):
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
         code = main(["--data", str(data), "--results", str(results), "--out", str(out),
-                     "--views", "ideal", "--no-run"])
+                     "--views", "ideal,train", "--no-run"])
     assert code == 0
     return out, buf.getvalue()
 

@@ -250,7 +250,7 @@ def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     result, while neural3d (100000 steps per building) still runs or waits."""
     results = tmp_path / "results"
     command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
-               "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-steps", "100000",
+               "--methods", "2D-S,neural3d", "--views", "ideal,train", "--neural3d-steps", "100000",
                "--results", str(results), "--out", str(tmp_path / "out"), "--executor", "ray",
                # three CPUs for its Ray: a training (2) and a 2D-S task (1) fit at once, so a
                # 2D-S result comes even when Ray starts the trainings first

@@ -23,7 +23,7 @@ def test_methods_run_on_an_imported_ifc_scene(tmp_path):
                           "--views", "8", "--resolution", "48", "--quiet"]) == 0
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         code = compare(["--data", str(data), "--methods", "2D-S,2D-SS,neural3d",
-                        "--views", "ideal", "--neural3d-preset", "tiny",
+                        "--views", "ideal,train", "--neural3d-preset", "tiny",
                         "--neural3d-steps", "150", "--neural3d-resolution", "32",
                         "--out", str(tmp_path / "out")])
     assert code == 0

@@ -15,7 +15,7 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     from baselines.wwr2dss import Wwr2dssConfig
     from neural3d.config import preset_config
 
-    specs = method_specs(("2D-S", "2D-SS", "neural3d"), ("ideal",), tmp_path,
+    specs = method_specs(("2D-S", "2D-SS", "neural3d"), ("ideal", "train"), tmp_path,
                          configs={"neural3d": Neural3dBudget(
                              preset="tiny", steps=300, max_minutes=1.5, resolution=96,
                              eval_frames=1)})
@@ -36,6 +36,19 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
     assert n3d.config["measure"] == asdict(MeasureConfig())
     (default,) = method_specs(("neural3d",), (), tmp_path)
     assert default.config["resolution"] == ExtractConfig().resolution
+
+
+def test_views_choose_the_protocols_each_method_declares(tmp_path):
+    """``--views`` names protocols; a method runs on those of them it declares."""
+    from envelope.protocols import DEFAULT_PROTOCOLS
+
+    def protocols(views):
+        return {s.name: s.protocols for s in method_specs(("2D-S", "neural3d"), views, tmp_path)}
+
+    assert protocols(DEFAULT_PROTOCOLS) == {"2D-S": ("ideal", "multi"), "neural3d": ("train",)}
+    assert protocols(("street",)) == {"2D-S": ("street",), "neural3d": ("street",)}
+    assert protocols(("ideal", "street")) == {"2D-S": ("ideal", "street"),
+                                              "neural3d": ("street",)}
 
 
 @pytest.mark.parametrize(

@@ -25,7 +25,7 @@ def test_metrics_compare_runs_every_method_on_imported_scenes(box_building, tmp_
     with contextlib.redirect_stdout(io.StringIO()):
         for src in (FIXTURES / "buildnet3d_generator" / "images/building0", tmp_path / "bproc"):
             assert generate_main(["--buildnet3d", str(src), "--out", str(data)]) == 0
-    argv = ["--data", str(data), "--methods", "2D-S,2D-SS,neural3d", "--views", "ideal",
+    argv = ["--data", str(data), "--methods", "2D-S,2D-SS,neural3d", "--views", "ideal,train",
             "--neural3d-preset", "tiny", "--neural3d-steps", "30",
             "--neural3d-resolution", "32", "--neural3d-threads", "2",
             "--results", str(tmp_path / "results"), "--out", str(tmp_path / "out")]

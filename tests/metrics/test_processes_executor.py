@@ -175,7 +175,7 @@ def test_ctrl_c_stops_the_trainings_with_checkpoints_and_whole_results(
     every result file is whole."""
     results = tmp_path / "results"
     command = [sys.executable, "-m", "metrics.compare", "--data", str(tiny_benchmark),
-               "--methods", "2D-S,neural3d", "--views", "ideal", "--neural3d-preset", "tiny",
+               "--methods", "2D-S,neural3d", "--views", "ideal,train", "--neural3d-preset", "tiny",
                "--neural3d-steps", "100000", "--neural3d-threads", "1", "--results",
                str(results), "--out", str(tmp_path / "out"), "--executor", "processes",
                "--cpus", "2"]

@@ -137,7 +137,7 @@ def test_a_result_cut_short_is_marked_in_every_table(tmp_path, capsys):
 def test_two_clean_comparisons_write_identical_tables(tiny_benchmark, tmp_path, monkeypatch):
     """Same command, same machine, clean caches: byte-identical tables (timing kept apart)."""
     argv = ["--data", str(tiny_benchmark), "--methods", "2D-S,2D-SS,neural3d",
-            "--views", "ideal", "--neural3d-preset", "tiny", "--neural3d-steps", "20",
+            "--views", "ideal,train", "--neural3d-preset", "tiny", "--neural3d-steps", "20",
             "--neural3d-resolution", "24", "--results", "results", "--out", "out"]
     texts = []
     for run in ("first", "second"):

@@ -30,6 +30,7 @@ class AnalyticField:
     def __init__(self, scene_dir: Path):
         self.scene_dir = scene_dir
         self.scene_name = scene_dir.name
+        self.split = "train"
         self.class_names = tuple(reversed(CLASS_NAMES))
         self.box_min_m = np.array([-4.0, -3.0, -0.5])
         self.box_max_m = np.array([4.0, 3.0, 11.0])
