@@ -57,7 +57,7 @@ def ready_made(tmp_path_factory):
     out = root / "compare"
     with contextlib.redirect_stdout(io.StringIO()):
         assert compare_main(["--data", str(data), "--results", str(results), "--out", str(out),
-                             "--views", "ideal", "--no-run"]) == 0
+                             "--views", "ideal,train", "--no-run"]) == 0
     _add_frame(data / "sky_a")
     for kind, shape in (("mask", (20, 30, 3)), ("corners", (20, 30, 3)),
                         ("rectified", (16, 24, 3))):

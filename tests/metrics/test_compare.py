@@ -188,7 +188,7 @@ def test_a_second_comparison_leaves_no_stale_plot_or_footprint(tmp_path):
     data, results = make_benchmark(tmp_path)
     out = tmp_path / "out"
     base = ["--data", str(data), "--results", str(results), "--out", str(out), "--no-run",
-            "--views", "ideal"]
+            "--views", "ideal,train"]
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         assert main(base) == 0
         assert (out / "plots" / "iou_per_building.png").is_file()
