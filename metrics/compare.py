@@ -87,7 +87,7 @@ def compare_once(request: CompareRequest, command: str, *, allow_run: bool, reus
     comparison = compare(data, specs, results, out, allow_run=allow_run,
                          reuse_stale=reuse_stale, command=command, execute=execute)
     print()
-    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
+    for table in comparison.printed:
         print(to_text(table))
     print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
           f"(results in {results}); {time.perf_counter() - start:.0f} s")
