@@ -87,7 +87,7 @@ def compare_once(request: CompareRequest, command: str, *, allow_run: bool, reus
     comparison = compare(data, specs, results, out, allow_run=allow_run,
                          reuse_stale=reuse_stale, command=command, execute=execute)
     print()
-    for table in (comparison.table2, comparison.table3, *comparison.more_tables):
+    for table in comparison.printed:
         print(to_text(table))
     print(f"wrote tables, plots and {PROVENANCE_FILE} to {out} "
           f"(results in {results}); {time.perf_counter() - start:.0f} s")
@@ -97,21 +97,23 @@ def compare_once(request: CompareRequest, command: str, *, allow_run: bool, reus
 def compare_on_masks(request: CompareRequest, command: str, *, allow_run: bool,
                      reuse_stale: bool, execute: Execute) -> int:
     """``--masks predicted[:MODEL]``: the comparison on the exact masks and on a segmenter's
-    (:mod:`metrics.predicted_masks`); print the table of both side by side. The segmenter is
-    loaded first: refused weights or plugins stop the run before anything is made."""
+    (:mod:`metrics.predicted_masks`); print the table of both side by side (scenes without
+    truth: the predicted-mask estimates). The segmenter is loaded first: refused weights or
+    plugins stop the run before anything is made."""
     start = time.perf_counter()
     assert request.masks is not None
     segmenter = masks_segmenter(request.masks)
     _prepare(request, comparisons=2, inputs="exact and predicted masks")
-    table, run = compare_on_predicted_masks(
+    tables, run = compare_on_predicted_masks(
         segmenter, request.data, request.results, request.out,
         lambda results: _specs(request, results), command=command, allow_run=allow_run,
         reuse_stale=reuse_stale, execute=execute)
     print()
-    print(to_text(table))
-    print(f"wrote the exact-mask outputs to {request.out}, the predicted-mask outputs and "
-          f"{table.name} to {run.out} (masks in {run.data}, results in {run.results}); "
-          f"{time.perf_counter() - start:.0f} s")
+    for table in tables:
+        print(to_text(table))
+    print(f"wrote the exact-mask outputs to {request.out}, the predicted-mask outputs"
+          + "".join(f" and {t.name}" for t in tables) + f" to {run.out} (masks in {run.data}, "
+          f"results in {run.results}); {time.perf_counter() - start:.0f} s")
     return 0
 
 

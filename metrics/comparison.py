@@ -22,6 +22,7 @@ from envelope.atomic import write_json_atomic, write_text_atomic
 from envelope.results import code_version
 from envelope.scenes.scene import find_scene_folders
 from envelope.truth import BuildingTruth, read_building
+from metrics.export.command import FORMATS, comparison_inputs, export
 from metrics.report.compare_outputs import (
     keep_pipeline_images,
     write_footprints,
@@ -29,6 +30,10 @@ from metrics.report.compare_outputs import (
     write_plots,
 )
 from metrics.report.report import (
+    PER_BUILDING_NAME,
+    PER_FACADE_NAME,
+    TABLE2_NAME,
+    TABLE3_NAME,
     per_building_table,
     per_facade_table,
     table2_errors,
@@ -41,6 +46,7 @@ from metrics.report.report_data import (
     PROVENANCE_FILE,
     report_data,
 )
+from metrics.report.report_estimates import ESTIMATES_NAME, estimates_table
 from metrics.report.report_facades import FACADE_SCORES_NAME, facade_scores_table
 from metrics.report.report_orientation import orientation_table
 from metrics.report.report_paper import (
@@ -66,32 +72,50 @@ from metrics.score.errors import (
 )
 from metrics.score.errors import failed_building as failed_row
 from metrics.score.orientation_errors import (
+    ORIENTATION_TABLE_NAME,
     orientation_errors_of,
     summarise_orientations,
 )
 
 PLOTS_FOLDER = "plots"
+EXPORT_FOLDER = "export"  # the energy exports of a comparison with scenes without truth
 CLAIMS_TABLE_NAMES = (TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME,
                       FACADE_SCORES_NAME)
+TABLE_NAMES = (TABLE2_NAME, TABLE3_NAME, *CLAIMS_TABLE_NAMES, ORIENTATION_TABLE_NAME,
+               ESTIMATES_NAME)
+"""Every table a comparison may write; one it did not make this time leaves no file."""
 
 
 @dataclass(frozen=True)
 class Comparison:
-    """What one comparison produced: per-building and per-facade rows and the tables."""
+    """What one comparison produced: per-building and per-facade rows and the tables.
+
+    ``rows`` and ``facade_rows`` are the scored ones: of the scenes with truth. Where no
+    scene has truth there is nothing to score: no rows, ``table2`` and ``table3`` are
+    ``None``. ``estimates``: each method's figures on every scene, made where a scene lacks
+    truth (:mod:`metrics.report.report_estimates`).
+    """
 
     rows: tuple[BuildingErrors, ...]
     facade_rows: tuple[FacadeErrors, ...]
-    table2: Table
-    table3: Table
+    table2: Table | None
+    table3: Table | None
     outcomes: tuple[Outcome, ...]
     more_tables: tuple[Table, ...] = ()  # visible truth, seed spread, the paper's, facade scores
     orientation: Table | None = None  # WWR error per facade orientation
+    estimates: Table | None = None
 
     @property
     def tables(self) -> tuple[Table, ...]:
         """Every table it writes as CSV, Markdown and LaTeX, in that order."""
-        return (self.table2, self.table3, *self.more_tables,
-                *((self.orientation,) if self.orientation is not None else ()))
+        return tuple(t for t in (self.table2, self.table3, *self.more_tables, self.orientation,
+                                 self.estimates) if t is not None)
+
+    @property
+    def printed(self) -> tuple[Table, ...]:
+        """The tables the command prints: Tables 2 and 3, the claims' tables, the estimates."""
+        return tuple(t for t in (self.table2, self.table3, *self.more_tables, self.estimates)
+                     if t is not None)
 
 
 def compare(
@@ -113,6 +137,10 @@ def compare(
     header names the command, code version and budgets, never a time; the run
     times go to ``timing.csv`` and the moment to ``provenance.json``.
 
+    Scenes without truth (no ``building.json``) are run like the others but not scored: the
+    errors are over the scenes with truth (none: no error table at all), and the estimates
+    table and the energy exports (``export/``, :mod:`metrics.export`) cover every scene.
+
     Raises
     ------
     ValueError
@@ -122,48 +150,75 @@ def compare(
     outcomes = run_missing(scene_dirs, specs, results_dir, allow_run=allow_run,
                            reuse_stale=reuse_stale, execute=execute)
     truths = {d.name: _read_truth(d) for d in scene_dirs}
-    rows, facade_rows = evaluate(outcomes, truths)
-    groups = aggregate_by_family(rows)
-    footprint_methods = {s.name for s in specs if s.has_footprint}
+    without_truth = [name for name, truth in truths.items() if truth is None]
+    every_row, facade_rows = evaluate(outcomes, truths)
+    rows = [r for r in every_row if truths.get(r.scene) is not None]
     footer = f"made by {methods_provenance_text(specs)}; details in {PROVENANCE_FILE}"
-    table2, table3 = table2_errors(groups), table3_footprint_iou(groups, footprint_methods)
-    orientation = orientation_table(summarise_orientations(orientation_errors_of(
-        (o.result, truths.get(o.scene)) for o in outcomes if o.result is not None)))
-    comparison = Comparison(
-        rows=tuple(rows),
-        facade_rows=tuple(facade_rows),
-        table2=replace(table2, notes=(*table2.notes, footer)),
-        table3=replace(table3, notes=(*table3.notes, footer)),
-        outcomes=tuple(outcomes),
-        more_tables=(*claims_tables(groups, paper_names_of(specs)),
-                     *((facade_scores_table(facade_rows, groups),) if facade_rows else ())),
-        orientation=replace(orientation, notes=(*orientation.notes, footer)),
-    )
+    estimates, truth_notes = None, ()
+    if without_truth:
+        estimates = estimates_table(outcomes, without_truth)
+        truth_notes = estimates.notes
+        estimates = replace(estimates, notes=(*truth_notes, footer))
+    comparison = Comparison(rows=tuple(rows), facade_rows=tuple(facade_rows), table2=None,
+                            table3=None, outcomes=tuple(outcomes), estimates=estimates)
+    groups = aggregate_by_family(rows)
+    if rows:
+        comparison = replace(comparison, **_error_tables(
+            groups, facade_rows, outcomes, truths, specs, (*truth_notes, footer)))
     provenance = _provenance(data, results_dir, specs, outcomes, command)
+    if without_truth:
+        provenance["scenes_without_truth"] = without_truth
     _write_tables(comparison, out_dir, f"produced by `{command}`; {footer}")
     write_plots(groups, rows, out_dir / PLOTS_FOLDER)
     write_footprints(outcomes, out_dir / FOOTPRINTS_FOLDER)
+    if without_truth:
+        export(comparison_inputs({n: t for n, t in truths.items() if t is not None},
+                                 [o.result for o in outcomes if o.result is not None]),
+               out_dir / EXPORT_FOLDER, FORMATS,
+               produced_by=f"{command}; {'; '.join(truth_notes)}")
     for spec in specs:
         write_mesh_pointers(scene_dirs, spec, out_dir)
     with_images = [s for s in specs if s.debug_images is not None]
     if allow_run and with_images:
         keep_pipeline_images(scene_dirs, with_images[0], out_dir / PIPELINE_FOLDER)
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
-    write_html_report(report_data(comparison.tables, rows, provenance, out_dir))
+    write_html_report(report_data(comparison.tables, every_row, provenance, out_dir))
     return comparison
 
 
+def _error_tables(groups: Sequence[GroupSummary], facade_rows: Sequence[FacadeErrors],
+                  outcomes: Sequence[Outcome], truths: Mapping[str, BuildingTruth | None],
+                  specs: Sequence[MethodSpec], notes: tuple[str, ...]) -> dict[str, object]:
+    """Tables 2 and 3, the claims' tables and the orientation errors of the scored rows,
+    each ending with ``notes``."""
+    footprint_methods = {s.name for s in specs if s.has_footprint}
+    table2, table3 = table2_errors(groups), table3_footprint_iou(groups, footprint_methods)
+    orientation = orientation_table(summarise_orientations(orientation_errors_of(
+        (o.result, truths.get(o.scene)) for o in outcomes if o.result is not None)))
+    return {
+        "table2": replace(table2, notes=(*table2.notes, *notes)),
+        "table3": replace(table3, notes=(*table3.notes, *notes)),
+        "more_tables": (*claims_tables(groups, paper_names_of(specs)),
+                        *((facade_scores_table(facade_rows, groups),) if facade_rows else ())),
+        "orientation": replace(orientation, notes=(*orientation.notes, *notes)),
+    }
+
+
 def _write_tables(comparison: Comparison, out_dir: Path, comment: str) -> None:
-    """The tables (CSV, Markdown, LaTeX; none left of a claims table without rows this
-    time) and the per-building, per-facade and timing CSVs, each headed by ``comment``."""
+    """The tables (CSV, Markdown, LaTeX; none left of a table not made this time) and the
+    per-building, per-facade (where something was scored) and timing CSVs, each headed by
+    ``comment``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     for table in comparison.tables:
         write_table(table, out_dir, comment)
-    for name in set(CLAIMS_TABLE_NAMES) - {t.name for t in comparison.more_tables}:
+    for name in set(TABLE_NAMES) - {t.name for t in comparison.tables}:
         for suffix in (".csv", ".md", ".tex"):
             (out_dir / f"{name}{suffix}").unlink(missing_ok=True)
-    for table in (per_building_table(comparison.rows), per_facade_table(comparison.facade_rows),
-                  timing_table(run_timings(comparison.outcomes))):
+    scored = ((per_building_table(comparison.rows), per_facade_table(comparison.facade_rows))
+              if comparison.table2 is not None else ())
+    for name in () if scored else (PER_BUILDING_NAME, PER_FACADE_NAME):
+        (out_dir / f"{name}.csv").unlink(missing_ok=True)
+    for table in (*scored, timing_table(run_timings(comparison.outcomes))):
         write_text_atomic(out_dir / f"{table.name}.csv", to_csv(table, comment))
 
 

@@ -4,7 +4,8 @@ The comparison on the exact masks runs (reusing its stored results), then the sa
 scene copies with the segmenter's masks (:mod:`metrics.run.predicted_masks`); the truth stays
 the exact one. ``<out>-masks-<key>`` gets, beside the usual outputs, ``exact_vs_predicted``
 (CSV, Markdown, LaTeX): per building, the segmenter's window IoU and each method's WWR,
-window and facade error on exact and on predicted masks, and per family the means.
+window and facade error on exact and on predicted masks, and per family the means, over the
+scenes with truth (scenes without have estimates only, in each comparison's estimates table).
 """
 
 from __future__ import annotations
@@ -35,22 +36,33 @@ from segment.segmenter import Segmenter
 def compare_on_predicted_masks(
     segmenter: Segmenter, data: Path, results: Path, out: Path,
     specs_for: Callable[[Path], list[MethodSpec]], *, command: str, **options,
-) -> tuple[Table, PredictedRun]:
+) -> tuple[tuple[Table, ...], PredictedRun]:
     """Compare on exact masks and on ``segmenter``'s; write the table :data:`TABLE_NAME`
-    into the predicted run's ``out`` and return it with the run's folders (``options``
-    go to :func:`metrics.comparison.compare`; ``specs_for(results folder)`` makes the
-    methods' specs)."""
+    into the predicted run's ``out`` and return the tables to print with the run's folders
+    (``options`` go to :func:`metrics.comparison.compare`; ``specs_for(results folder)``
+    makes the methods' specs).
+
+    The table scores the scenes with truth; where none has truth it is not written (nor
+    printed), and the predicted-mask comparison's estimates table is what there is to print
+    (:mod:`metrics.report.report_estimates`)."""
     specs = specs_for(results)
     exact = compare(data, specs, results, out, command=command, **options)
     run = predicted_run(data, results, out, segmenter, splits_read(specs))
     predicted = compare(run.data, with_predicted_masks(specs_for(run.results), segmenter),
                         run.results, run.out, command=command, **options)
     exact_dirs = {d.name: d for d in find_scene_folders(data)}
+    scored = {r.scene for r in exact.rows}
     ious = [masks_scene_iou(read_scene(exact_dirs[d.name]), read_scene(d))
-            for d in find_scene_folders(run.data) if d.name in exact_dirs]
+            for d in find_scene_folders(run.data) if d.name in scored]
     table = exact_vs_predicted_table(exact.rows, predicted.rows, ious, segmenter.name)
-    write_table(table, run.out, f"produced by `{command}`")
-    return table, run
+    if table.rows:
+        write_table(table, run.out, f"produced by `{command}`")
+    else:
+        for suffix in (".csv", ".md", ".tex"):
+            (run.out / f"{TABLE_NAME}{suffix}").unlink(missing_ok=True)
+    tables = ((table,) if table.rows else ()) + (
+        (predicted.estimates,) if predicted.estimates is not None else ())
+    return tables, run
 
 
 def exact_vs_predicted_table(exact: Sequence[BuildingErrors], predicted: Sequence[BuildingErrors],

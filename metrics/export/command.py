@@ -97,8 +97,16 @@ def read_inputs(results_dir: Path, data_dir: Path | None) -> ExportInputs:
                 skipped.append(str(exc))
                 continue
             truths[scene_dir.name] = truth
-    results.sort(key=lambda r: (r.scene, method_rank(r.method), protocol_rank(r.protocol)))
-    return ExportInputs(truths, tuple(results), tuple(skipped))
+    return comparison_inputs(truths, results, skipped)
+
+
+def comparison_inputs(truths: dict[str, BuildingTruth], results: Sequence[MethodResult],
+                      skipped: Sequence[str] = ()) -> ExportInputs:
+    """What an export reads, from what is in memory (a comparison's truths and results):
+    the results ordered by scene, method and views."""
+    ordered = sorted(results, key=lambda r: (r.scene, method_rank(r.method),
+                                             protocol_rank(r.protocol)))
+    return ExportInputs(truths, tuple(ordered), tuple(skipped))
 
 
 def export(inputs: ExportInputs, out_dir: Path, formats: Sequence[str], *,

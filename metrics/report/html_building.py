@@ -23,33 +23,43 @@ from metrics.report.report_data import FOOTPRINTS_FOLDER, PIPELINE_FOLDER
 from metrics.report.templating import render
 from metrics.run.mesh_pointers import MeshRun, read_mesh_pointers
 from metrics.score.aggregate import method_rank, protocol_rank
-from metrics.score.errors import BuildingErrors
+from metrics.score.errors import NO_TRUTH_FAMILY, BuildingErrors
 
 MAX_MESH_FACES = 20_000  # plotly's mesh3d stays smooth in a browser well beyond this
 COLUMNS = ("Method", "Views", "Status", "WWR", "WWR error (%)", "Window (m²)",
            "Window error (%)", "Facade (m²)", "Facade error (%)", "Footprint IoU", "Why / marks")
+ESTIMATE_COLUMNS = ("Method", "Views", "Status", "WWR", "Window (m²)", "Facade (m²)",
+                    "Why / marks")  # a building without truth: nothing to score
 
 
 def building_section(scene: str, rows: Sequence[BuildingErrors], data: Path,
                      out_dir: Path) -> Markup:
-    """One building: truth, each method's estimates and errors, images, footprints, mesh."""
+    """One building: truth, each method's estimates and errors, images, footprints, mesh;
+    a building without truth (family :data:`~metrics.score.errors.NO_TRUTH_FAMILY`): says so,
+    and its estimates without error columns."""
     scene_dir = data / scene if (data / scene).is_dir() else data
     first = rows[0]
-    truth = [("family", first.family),
-             ("WWR", number_cell(first.wwr_true, ".4f")[0]),
-             ("window area (m²)", number_cell(first.window_true_m2, ".2f")[0]),
-             ("facade area (m²)", number_cell(first.facade_true_m2, ".2f")[0])]
+    scored = first.family != NO_TRUTH_FAMILY
+    truth = ([("family", first.family),
+              ("WWR", number_cell(first.wwr_true, ".4f")[0]),
+              ("window area (m²)", number_cell(first.window_true_m2, ".2f")[0]),
+              ("facade area (m²)", number_cell(first.facade_true_m2, ".2f")[0])] if scored
+             else [("ground truth", "none (no building.json): estimates only, no errors")])
     ordered = sorted(rows, key=lambda r: (method_rank(r.method), protocol_rank(r.protocol)))
     cells = []
     for r in ordered:
         note = "; ".join(x for x in (r.reason, r.marks) if x)
-        cells.append([(r.method, r.method), (r.protocol, r.protocol), (r.status, r.status),
-                      number_cell(r.wwr_est, ".4f"), number_cell(r.wwr_ape, ".2f"),
-                      number_cell(r.window_est_m2, ".2f"), number_cell(r.window_ape, ".2f"),
-                      number_cell(r.facade_est_m2, ".2f"), number_cell(r.facade_ape, ".2f"),
-                      number_cell(r.footprint_iou, ".3f"), (note, note)])
+        errors = ([number_cell(r.wwr_ape, ".2f"), number_cell(r.window_ape, ".2f"),
+                   number_cell(r.facade_ape, ".2f")] if scored else [])
+        row = [(r.method, r.method), (r.protocol, r.protocol), (r.status, r.status),
+               number_cell(r.wwr_est, ".4f"), *errors[:1], number_cell(r.window_est_m2, ".2f"),
+               *errors[1:2], number_cell(r.facade_est_m2, ".2f"), *errors[2:]]
+        if scored:
+            row.append(number_cell(r.footprint_iou, ".3f"))
+        cells.append([*row, (note, note)])
     footprints, footprints_error = _footprints(scene, scene_dir, out_dir)
-    return render("building.html.j2", scene=scene, truth=truth, columns=COLUMNS, rows=cells,
+    return render("building.html.j2", scene=scene, truth=truth,
+                  columns=COLUMNS if scored else ESTIMATE_COLUMNS, rows=cells,
                   attrs=[{"status": r.status} for r in ordered], footprints=footprints,
                   footprints_error=footprints_error, images=_images(scene, scene_dir, out_dir),
                   meshes=[_mesh(run, i) for i, run in enumerate(

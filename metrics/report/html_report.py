@@ -5,7 +5,9 @@ once into the same :class:`~metrics.report.report_data.ReportData`).
 
 The page is rendered from jinja2 templates (``templates/``, autoescaped): Tables 2 and 3 with
 the paper's figures beside ours, the claims' qualifiers, charts, the per-orientation errors,
-one section per building and the provenance. plotly.js and every image are embedded, so the
+one section per building and the provenance. Where a scene has no ground truth the page says
+so first and shows the estimates table (:mod:`metrics.report.html_estimates`); where none
+has, there are no error tables or charts at all. plotly.js and every image are embedded, so the
 file opens offline and can be sent on its own.
 """
 
@@ -23,6 +25,7 @@ from markupsafe import Markup
 from envelope.atomic import write_text_atomic
 from metrics.report.html_building import building_section
 from metrics.report.html_claims import claims_sections
+from metrics.report.html_estimates import estimates_section
 from metrics.report.html_orientation import orientation_section
 from metrics.report.html_sections import Cell, chart, colour, label_cell, summary_cell
 from metrics.report.paper_tables import (
@@ -33,11 +36,12 @@ from metrics.report.paper_tables import (
 )
 from metrics.report.report import TABLE2_NAME, TABLE3_NAME
 from metrics.report.report_data import Record, ReportData, read_report_data
+from metrics.report.report_estimates import ESTIMATES_NAME, truth_note
 from metrics.report.report_paper import PAPER_TABLE2_NAME, PAPER_TABLE3_NAME
 from metrics.report.templating import render
 from metrics.score.aggregate import Summary, family_rank, method_rank, protocol_rank
 from metrics.score.bootstrap import INTERVAL_TEXT
-from metrics.score.errors import BuildingErrors
+from metrics.score.errors import NO_TRUTH_FAMILY, BuildingErrors
 from metrics.score.orientation_errors import ORIENTATION_TABLE_NAME
 
 REPORT_FILE = "report.html"
@@ -64,9 +68,13 @@ def build_report(data: ReportData) -> str:
     scenes = sorted({(r.family, r.scene) for r in data.rows},
                     key=lambda s: (family_rank(s[0]), s[1]))
     source = Path(data.provenance.get("data", ""))
+    without_truth = sorted({s for f, s in scenes if f == NO_TRUTH_FAMILY})
     return render(
         "report.html.j2", plotly_js=get_plotlyjs(),
         produced_by=data.provenance.get("produced_by", ""),
+        scored=TABLE2_NAME in data.tables,
+        estimates=estimates_section(data.table(ESTIMATES_NAME),
+                                    truth_note(without_truth, len(scenes))),
         table2=table2_html(table2, data.table(PAPER_TABLE2_NAME)),
         table3=table3_html(data.table(TABLE3_NAME), data.table(PAPER_TABLE3_NAME)),
         claims=claims_sections(data.tables), errors_chart=errors_chart(table2),

@@ -26,6 +26,7 @@ from metrics.report.report import (
     TABLE3_NAME,
     read_building_errors_csv,
 )
+from metrics.report.report_estimates import ESTIMATES_NAME, estimate_rows
 from metrics.report.report_paper import PAPER_TABLE2_NAME, PAPER_TABLE3_NAME
 from metrics.report.report_seeds import SEED_TABLE_NAME
 from metrics.report.report_visible import TABLE2_VISIBLE_NAME
@@ -37,9 +38,10 @@ PROVENANCE_FILE = "provenance.json"
 PIPELINE_FOLDER = "2dss_pipeline"  # one facade's pipeline images (the first that writes them)
 FOOTPRINTS_FOLDER = "footprints"  # the estimated footprints, <scene>__<method>__<views>.geojson
 REPORT_TABLES = (TABLE2_NAME, TABLE3_NAME, PAPER_TABLE2_NAME, PAPER_TABLE3_NAME,
-                 TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, ORIENTATION_TABLE_NAME)
+                 TABLE2_VISIBLE_NAME, SEED_TABLE_NAME, ORIENTATION_TABLE_NAME, ESTIMATES_NAME)
 """The tables the page shows (each where the comparison made it)."""
-REQUIRED = (TABLE2_NAME, TABLE3_NAME)
+SCORED = (TABLE2_NAME, TABLE3_NAME, PER_BUILDING_NAME)
+"""What a comparison that scored something wrote (one on scenes without truth: the estimates)."""
 _NUMBER = re.compile(r"-?\d+(\.\d+)?([eE][-+]?\d+)?")
 
 Record = Mapping[str, Cell]
@@ -73,22 +75,29 @@ def report_data(tables: Sequence[Table], rows: Sequence[BuildingErrors],
 
 
 def read_report_data(out_dir: Path) -> ReportData:
-    """The page's input read back from a comparison's output folder.
+    """The page's input read back from a comparison's output folder: the scored rows of
+    ``per_building.csv`` and, for the scenes without truth, the estimates table's.
 
     Raises
     ------
     ValueError
-        If ``out_dir`` lacks Table 2, Table 3, ``per_building.csv`` or the provenance.
+        If ``out_dir`` lacks the provenance, or both the estimates table and one of Table 2,
+        Table 3 and ``per_building.csv``.
     """
-    for name in (*(f"{n}.csv" for n in (*REQUIRED, PER_BUILDING_NAME)), PROVENANCE_FILE):
+    scored = all((out_dir / f"{n}.csv").is_file() for n in SCORED)
+    wanted = ((f"{n}.csv" for n in SCORED) if scored or not (out_dir / f"{ESTIMATES_NAME}.csv")
+              .is_file() else ())
+    for name in (*wanted, PROVENANCE_FILE):
         if not (out_dir / name).is_file():
             raise ValueError(f"{out_dir / name} does not exist; run `python -m metrics.compare "
                              f"--out {out_dir}` first")
     tables = {name: read_table_records((out_dir / f"{name}.csv").read_text())
               for name in REPORT_TABLES if (out_dir / f"{name}.csv").is_file()}
-    return ReportData(json.loads((out_dir / PROVENANCE_FILE).read_text()),
-                      tuple(read_building_errors_csv(out_dir / f"{PER_BUILDING_NAME}.csv")),
-                      tables, out_dir)
+    rows = read_building_errors_csv(out_dir / f"{PER_BUILDING_NAME}.csv") if scored else []
+    have = {r.scene for r in rows}
+    rows += estimate_rows([r for r in tables.get(ESTIMATES_NAME, ()) if r["scene"] not in have])
+    return ReportData(json.loads((out_dir / PROVENANCE_FILE).read_text()), tuple(rows), tables,
+                      out_dir)
 
 
 def table_records(table: Table) -> tuple[dict[str, Cell], ...]:
