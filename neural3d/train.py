@@ -137,7 +137,7 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
     occupancy = make_occupancy(config, box_min, box_max)
     measured = field if average is None else average
     if resume and occupancy is not None and "occupancy" in state:
-        occupancy.occupied = state["occupancy"].to(device)
+        occupancy.occupied.copy_(state["occupancy"])
 
     def save() -> None:
         write_checkpoint(run_dir / CHECKPOINT_NAME, {
