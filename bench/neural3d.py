@@ -183,7 +183,8 @@ def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.
         print(f"  {scene_dir.name} step {step}: {row}", flush=True)
         return stop_at_target and on_target(row)
 
-    train(scene_dir, config, out_dir, device=device, max_seconds=60.0 * minutes, callback=check)
+    train(read_method_input(scene_dir), config, out_dir, device=device,
+          max_seconds=60.0 * minutes, callback=check)
     return {"scene": scene_dir.name, "family": truth.type if truth else None, "checks": checks,
             "target_reached": next((c for c in checks if on_target(c)), None),
             "final": checks[-1] if checks else None, "last3_spread": last_checks_spread(checks)}
