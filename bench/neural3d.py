@@ -49,7 +49,12 @@ from neural3d.training.data import (  # noqa: E402
     load_frames,
     scene_normalisation,
 )
-from neural3d.training.step import make_occupancy, make_optimizer, train_step  # noqa: E402
+from neural3d.training.step import (  # noqa: E402
+    StepResult,
+    make_occupancy,
+    make_optimizer,
+    train_step,
+)
 
 WWR_TARGET_PCT = 5.0
 IOU_TARGET = 0.96
@@ -71,11 +76,12 @@ class TrainingState:
     average: torch.nn.Module | None
     config: TrainConfig
 
-    def step(self, i: int) -> None:
+    def step(self, i: int) -> StepResult:
         """Training step ``i`` (``train_step``, weight averaging included)."""
-        train_step(self.field, self.optimizer, self.scheduler, self.pixels, self.box_min,
-                   self.box_max, self.config, step=i, background_class=self.background_class,
-                   generator=self.generator, occupancy=self.occupancy, average=self.average)
+        return train_step(self.field, self.optimizer, self.scheduler, self.pixels, self.box_min,
+                          self.box_max, self.config, step=i,
+                          background_class=self.background_class, generator=self.generator,
+                          occupancy=self.occupancy, average=self.average)
 
 
 def training_state(scene_dir: Path, config: TrainConfig, device: torch.device) -> TrainingState:
@@ -177,7 +183,8 @@ def converge_scene(scene_dir: Path, config: TrainConfig, extract, device: torch.
         print(f"  {scene_dir.name} step {step}: {row}", flush=True)
         return stop_at_target and on_target(row)
 
-    train(scene_dir, config, out_dir, device=device, max_seconds=60.0 * minutes, callback=check)
+    train(read_method_input(scene_dir), config, out_dir, device=device,
+          max_seconds=60.0 * minutes, callback=check)
     return {"scene": scene_dir.name, "family": truth.type if truth else None, "checks": checks,
             "target_reached": next((c for c in checks if on_target(c)), None),
             "final": checks[-1] if checks else None, "last3_spread": last_checks_spread(checks)}

@@ -75,6 +75,13 @@ class TrainConfig:
     # On in fast: about half the samples late in training, 0.7-0.85x the training time
     # (docs/decisions.md, 2026-11-27 "samples guessed light")
     min_estimated_weight: float = 1e-4
+    # fixed-shape step (neural3d.rendering.fixed_shape): 0 = off, the step renders only the rays
+    # that hit and evaluates only the samples it keeps (shapes that follow the data); N > 0 =
+    # every ray is rendered and the field is evaluated at N sample slots a batch (padded and
+    # masked; candidates beyond N are dropped and counted), so no shape depends on the data
+    # and the step can be captured as a CUDA graph. Off in every preset (docs/decisions.md,
+    # 2026-11-29 "a fixed-shape step, off")
+    sample_buffer: int = 0
     cos_anneal_steps: int = 0  # NeuS cos-anneal length; 0 = no annealing
     rgb_weight: float = 1.0
     eikonal_weight: float = 0.1
@@ -119,6 +126,9 @@ class TrainConfig:
         if not 0.0 <= self.min_estimated_weight < 1.0:
             raise ValueError(f"TrainConfig.min_estimated_weight must be in [0, 1), got "
                              f"{self.min_estimated_weight}")
+        if self.sample_buffer < 0:
+            raise ValueError(f"TrainConfig.sample_buffer must be >= 0 (0 = off), got "
+                             f"{self.sample_buffer}")
         if self.eval_rays_per_frame < 0:
             raise ValueError(f"TrainConfig.eval_rays_per_frame must be >= 0 (0 = every pixel), "
                              f"got {self.eval_rays_per_frame}")

@@ -137,7 +137,7 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
     occupancy = make_occupancy(config, box_min, box_max)
     measured = field if average is None else average
     if resume and occupancy is not None and "occupancy" in state:
-        occupancy.occupied = state["occupancy"].to(device)
+        occupancy.occupied.copy_(state["occupancy"])
 
     def save() -> None:
         write_checkpoint(run_dir / CHECKPOINT_NAME, {
@@ -153,6 +153,7 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
     bar = progress_bar(total=config.iterations, initial=step, desc=f"neural3d {run_dir.name}",
                        dynamic_ncols=True, disable=None)
     previous_sigterm = _sigterm_as_interrupt()
+    dropped = 0  # candidates the fixed-shape step had no slot for, since the last log row
     try:
         while step < config.iterations:
             tic = time.perf_counter()
@@ -161,12 +162,15 @@ def train(scene: MethodInput, config: TrainConfig, out_dir: Path, *, device: tor
                                 occupancy=occupancy, average=average)
             step += 1
             train_s += time.perf_counter() - tic
+            dropped += result.dropped_samples
             bar.update(1)
             if step % LOG_EVERY == 0 or step == config.iterations:
                 row = {"step": step, "train_s": round(train_s, 3), "loss": result.loss,
                        **result.parts,
                        "psnr": psnr(result.render.rgb.detach(), pixels.rgb[result.pixel_index]),
-                       "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0]}
+                       "inv_s": float(field.inv_s().detach()), "lr": scheduler.get_last_lr()[0],
+                       **({"dropped_samples": dropped} if config.sample_buffer else {})}
+                dropped = 0
                 log_rows.append(row)
                 write_log(run_dir, log_rows)
                 bar.set_postfix(loss=f"{row['loss']:.4f}", psnr=f"{row['psnr']:.2f}")
@@ -247,6 +251,9 @@ def main(argv: list[str] | None = None) -> int:
                              "default 1024); evaluation time is reported as eval_s")
     parser.add_argument("--depth-loss", action="store_true",
                         help="variant: also supervise rendered depth with the depth images")
+    parser.add_argument("--sample-buffer", type=int, default=None, metavar="N",
+                        help="variant: the fixed-shape training step, the field evaluated at "
+                             "N sample slots a batch (0 = off, the presets' default)")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
     run_dir = Path(args.out) / scene_name(args.scene)
@@ -260,6 +267,8 @@ def main(argv: list[str] | None = None) -> int:
                 config = replace(config, iterations=args.iterations)
             if args.depth_loss:
                 config = replace(config, depth_loss=True)
+            if args.sample_buffer is not None:
+                config = replace(config, sample_buffer=args.sample_buffer)
             if args.eval_every is not None:
                 config = replace(config, eval_every=args.eval_every)
             if args.eval_rays is not None:

@@ -29,7 +29,9 @@ class RenderOutput:
 
     rgb "(R, 3)", semantics "(R, C)" class probabilities, depth "(R,)" distance
     along the ray (0 for the sky), accumulation "(R,)", and the SDF gradients
-    "(M, 3)" at every sample of the rays that enter the box (for the eikonal term).
+    "(M, 3)" at every sample the field was evaluated at (for the eikonal term); of
+    these the eikonal term counts the rows ``sdf_gradient_mask`` "(M,)" bool marks
+    (None: all; the fixed-shape rendering's padded slots are not counted).
     """
 
     rgb: Tensor
@@ -37,6 +39,7 @@ class RenderOutput:
     depth: Tensor
     accumulation: Tensor
     sdf_gradients: Tensor
+    sdf_gradient_mask: Tensor | None = None
 
 
 def cos_anneal_ratio(config: TrainConfig, step: int) -> float:
@@ -85,7 +88,7 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
         cos = (grad * dirs_s).sum(-1)
         alpha = neus_alpha(sdf, cos, lengths, field.inv_s(),
                            cos_anneal_ratio=cos_anneal_ratio(config, step))
-        weights = weights_from_alpha(_on_all_samples(alpha, evaluated, n_all)
+        weights = weights_from_alpha(on_all_samples(alpha, evaluated, n_all)
                                      .reshape(n_rays, n_samples))
         kept = None  # rows of the evaluated samples the heads see; None = all
         if config.min_sample_weight > 0:  # light samples are dropped (as if transparent)
@@ -113,7 +116,7 @@ def render_rays(field: SemanticSDF, origins: Tensor, dirs: Tensor, box_min: Tens
         )
 
 
-def _on_all_samples(values: Tensor, rows: Tensor | None, n_all: int) -> Tensor:
+def on_all_samples(values: Tensor, rows: Tensor | None, n_all: int) -> Tensor:
     """Values "(M, ...)" at ``rows`` of the ray samples -> "(n_all, ...)", zeros elsewhere
     (samples the field was not evaluated at: transparent); ``values`` when ``rows`` is None."""
     if rows is None:
@@ -130,4 +133,4 @@ def _at_samples(head, kept: Tensor | None, evaluated: Tensor | None, n_all: int,
     """
     out = head(*inputs) if kept is None else head(*(x[kept] for x in inputs))
     rows = kept if evaluated is None else (evaluated if kept is None else evaluated[kept])
-    return _on_all_samples(out, rows, n_all)
+    return on_all_samples(out, rows, n_all)

@@ -69,8 +69,8 @@ def render_semantics(weights: Tensor, logits: Tensor, background_class: int = 0)
     """
     probs = (weights[..., None] * torch.softmax(logits, -1)).sum(1)
     rest = (1 - render_accumulation(weights)).clamp(min=0)
-    return probs.index_add(1, torch.tensor([background_class], device=probs.device),
-                           rest[:, None])
+    column = torch.full((1,), background_class, device=probs.device)  # no copy from the host
+    return probs.index_add(1, column, rest[:, None])
 
 
 def render_depth(weights: Tensor, t_mid: Tensor) -> Tensor:

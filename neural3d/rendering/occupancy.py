@@ -50,6 +50,8 @@ class OccupancyGrid:
         self.cell = float(extent.max()) / resolution
         self.shape = tuple(max(1, math.ceil(float(e) / self.cell - 1e-6)) for e in extent)
         self.occupied = torch.ones(self.shape, dtype=torch.bool, device=box_min.device)
+        # Probes every half cell along the box's diagonal: enough for any ray through the box.
+        self.probes_for_box = max(2, math.ceil(float(extent.norm()) / (0.5 * self.cell)))
 
     def fraction_occupied(self) -> float:
         """Share of cells that are occupied."""
@@ -68,10 +70,11 @@ class OccupancyGrid:
         ``sdf_fn``: "(N, 3)" -> "(N,)" in normalised units; ``margin`` in the same units.
         Block first: the SDF is taken at the centre of each block of 2 x 2 x 2 cells,
         and at a block's cells only when that could pass the test (:meth:`near_surface`).
+        ``occupied`` is written in place.
         """
         near_surface = self.near_surface(sdf_fn, margin=margin)
         grown = F.max_pool3d(near_surface[None, None].float(), 3, stride=1, padding=1)
-        self.occupied = grown[0, 0] > 0
+        self.occupied.copy_(grown[0, 0] > 0)  # in place: a captured step reads this tensor
 
     @torch.no_grad()
     def near_surface(self, sdf_fn: Callable[[Tensor], Tensor], *, margin: float,
@@ -103,15 +106,19 @@ class OccupancyGrid:
         return near.reshape(self.shape)
 
     def clip_rays(self, origins: Tensor, dirs: Tensor, near: Tensor, far: Tensor,
-                  hit: Tensor) -> tuple[Tensor, Tensor, Tensor]:
+                  hit: Tensor, *, n_probe: int | None = None) -> tuple[Tensor, Tensor, Tensor]:
         """Shrink [near, far] "(R,)" of rays "(R, 3)" to their first and last occupied cell.
 
-        The ray is probed every half cell; a ray with no occupied probe no longer hits.
-        Returns near, far, hit like :func:`neural3d.rendering.sampling.ray_box_near_far`.
+        Each ray is probed at ``n_probe`` evenly spaced points; None: as many as probe the
+        batch's longest ray every half cell (read on the host, so the probes' shape follows
+        the data; :attr:`probes_for_box` is a count fixed by the box, for the fixed-shape
+        step). A ray with no occupied probe no longer hits. Returns near, far, hit like
+        :func:`neural3d.rendering.sampling.ray_box_near_far`.
         """
-        if not bool(hit.any()):
-            return near, far, hit
-        n_probe = max(2, math.ceil(float((far - near)[hit].max()) / (0.5 * self.cell)))
+        if n_probe is None:
+            if not bool(hit.any()):
+                return near, far, hit
+            n_probe = max(2, math.ceil(float((far - near)[hit].max()) / (0.5 * self.cell)))
         s = (torch.arange(n_probe, device=near.device, dtype=near.dtype) + 0.5) / n_probe
         t = near[:, None] + (far - near)[:, None] * s  # (R, P)
         pts = origins[:, None, :] + dirs[:, None, :] * t[..., None]

@@ -25,11 +25,17 @@ def rgb_l1(rgb: Tensor, target_rgb: Tensor) -> Tensor:
     return (rgb - target_rgb).abs().mean()
 
 
-def eikonal(sdf_gradients: Tensor) -> Tensor:
-    """Mean of (|grad| - 1)^2 over "(M, 3)" gradients: an SDF has unit-norm gradients."""
+def eikonal(sdf_gradients: Tensor, mask: Tensor | None = None) -> Tensor:
+    """Mean of (|grad| - 1)^2 over "(M, 3)" gradients: an SDF has unit-norm gradients.
+
+    ``mask`` "(M,)" bool: only these rows count (0 when none does); None: every row.
+    """
     if len(sdf_gradients) == 0:
         return sdf_gradients.sum() * 0.0
-    return ((sdf_gradients.norm(dim=-1) - 1.0) ** 2).mean()
+    squares = (sdf_gradients.norm(dim=-1) - 1.0) ** 2
+    if mask is None:
+        return squares.mean()
+    return torch.where(mask, squares, 0.0).sum() / mask.sum().clamp(min=1)
 
 
 def semantic_nll(probs: Tensor, labels: Tensor) -> Tensor:
@@ -45,11 +51,11 @@ def mask_bce(accumulation: Tensor, foreground: Tensor) -> Tensor:
 
 
 def depth_l1(depth_t: Tensor, target_t: Tensor) -> Tensor:
-    """Mean |depth error| over rays with a target (NaN targets are skipped); "(R,)" each."""
+    """Mean |depth error| over rays with a target (NaN targets are skipped; 0 when every
+    one is); "(R,)" each. Masked, not selected: no shape or host read depends on the data."""
     valid = torch.isfinite(target_t)
-    if not valid.any():
-        return depth_t.sum() * 0.0
-    return (depth_t[valid] - target_t[valid]).abs().mean()
+    error = (depth_t - torch.where(valid, target_t, 0.0)).abs()
+    return torch.where(valid, error, 0.0).sum() / valid.sum().clamp(min=1)
 
 
 def psnr(rgb: Tensor, target_rgb: Tensor) -> float:
@@ -60,11 +66,12 @@ def psnr(rgb: Tensor, target_rgb: Tensor) -> float:
 
 def total_loss(out: RenderOutput, rgb: Tensor, labels: Tensor, config: TrainConfig, *,
                background_class: int, depth_t: Tensor | None = None
-               ) -> tuple[Tensor, dict[str, float]]:
-    """Weighted sum of the configured losses and each term's value (for the log)."""
+               ) -> tuple[Tensor, dict[str, Tensor]]:
+    """Weighted sum of the configured losses and each term's value "()" (detached, for the
+    log; left on the device: reading it is the caller's host sync)."""
     terms = {
         "rgb": (config.rgb_weight, rgb_l1(out.rgb, rgb)),
-        "eikonal": (config.eikonal_weight, eikonal(out.sdf_gradients)),
+        "eikonal": (config.eikonal_weight, eikonal(out.sdf_gradients, out.sdf_gradient_mask)),
         "semantic": (config.semantic_weight, semantic_nll(out.semantics, labels)),
     }
     if config.mask_weight > 0:
@@ -75,4 +82,4 @@ def total_loss(out: RenderOutput, rgb: Tensor, labels: Tensor, config: TrainConf
             raise ValueError("depth_loss is on but the batch has no depth")
         terms["depth"] = (config.depth_weight, depth_l1(out.depth, depth_t))
     total = sum(w * v for w, v in terms.values())
-    return total, {k: float(v.detach()) for k, (_, v) in terms.items()}
+    return total, {k: v.detach() for k, (_, v) in terms.items()}

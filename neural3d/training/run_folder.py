@@ -40,7 +40,9 @@ PriorRun = Literal["none", "partial", "finished"]
 before the step budget (resume it), or a finished training (reuse it)."""
 
 LOG_FIELDS = ("step", "train_s", "loss", "rgb", "eikonal", "semantic", "mask", "depth", "psnr",
-              "inv_s", "lr")
+              "inv_s", "lr", "dropped_samples")
+"""log.csv's columns; ``dropped_samples`` (candidates the fixed-shape step had no slot for,
+over the steps since the previous row) is empty unless ``sample_buffer`` is on."""
 
 
 def training_provenance(scene_dir: Path, config: TrainConfig, device: torch.device, *,

@@ -1,7 +1,10 @@
 """One training step of the semantic SDF, and what it needs: optimiser, schedule, EMA, grid.
 
 :func:`train_step` is the only training step: ``neural3d.train`` loops over it
-and ``bench/neural3d.py`` times it.
+and ``bench/neural3d.py`` times it. With ``config.sample_buffer`` > 0 it renders the
+batch with :func:`neural3d.rendering.fixed_shape.render_rays_fixed_shape` (every shape
+fixed, no host read until the optimiser has stepped); otherwise with
+:func:`neural3d.rendering.model.render_rays`.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from torch.profiler import record_function
 
 from neural3d.config import TrainConfig
 from neural3d.field.fields import SemanticSDF
+from neural3d.rendering.fixed_shape import render_rays_fixed_shape
 from neural3d.rendering.model import RenderOutput, render_rays
 from neural3d.rendering.occupancy import OccupancyGrid
 from neural3d.training.data import Pixels
@@ -53,6 +57,7 @@ class StepResult:
     parts: dict[str, float]
     pixel_index: torch.Tensor  # "(R,)" rows of the pixels the batch used
     render: RenderOutput
+    dropped_samples: int = 0  # candidates the fixed-shape step had no slot for (else 0)
 
 
 @torch.no_grad()
@@ -84,6 +89,8 @@ def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
     ``occupancy`` grid, rays skip empty space; the grid is refreshed from the SDF
     at ``occupancy_start`` and every ``occupancy_every`` steps after. With an
     ``average`` (a copy of ``field``), it follows ``field`` by ``config.ema_decay``.
+    ``config.sample_buffer`` > 0: the fixed-shape rendering (module docstring); the
+    values it reports are read on the host only after the optimiser and EMA updates.
     Each part runs under a ``neural3d.<part>`` profiler label (bench/neural3d_profile.py).
     """
     field.set_step(step)
@@ -98,9 +105,15 @@ def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
         origins, dirs, rgb, labels = (pixels.origins[idx], pixels.dirs[idx], pixels.rgb[idx],
                                       pixels.labels[idx])
         depth_t = pixels.depth_t[idx] if pixels.depth_t is not None else None
-    out = render_rays(field, origins, dirs, box_min, box_max, config, step=step, training=True,
-                      background_class=background_class, generator=generator,
-                      occupancy=occupancy)
+    dropped = None
+    if config.sample_buffer > 0:
+        out, dropped = render_rays_fixed_shape(field, origins, dirs, box_min, box_max, config,
+                                               step=step, background_class=background_class,
+                                               generator=generator, occupancy=occupancy)
+    else:
+        out = render_rays(field, origins, dirs, box_min, box_max, config, step=step,
+                          training=True, background_class=background_class,
+                          generator=generator, occupancy=occupancy)
     with record_function("neural3d.losses"):
         loss, parts = total_loss(out, rgb, labels, config, background_class=background_class,
                                  depth_t=depth_t)
@@ -114,4 +127,5 @@ def train_step(field: SemanticSDF, optimizer: torch.optim.Optimizer,
     if average is not None:
         with record_function("neural3d.weight averaging"):
             update_ema(average, field, config.ema_decay)
-    return StepResult(float(loss.detach()), parts, idx, out)
+    return StepResult(float(loss.detach()), {k: float(v) for k, v in parts.items()}, idx, out,
+                      0 if dropped is None else int(dropped))

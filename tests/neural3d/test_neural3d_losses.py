@@ -44,3 +44,16 @@ def test_total_is_the_weighted_sum():
     assert set(parts) == {"rgb", "eikonal", "semantic", "mask"}
     with pytest.raises(ValueError, match="no depth"):
         total_loss(out, rgb, labels, replace(c, depth_loss=True), background_class=0)
+
+
+def test_masked_eikonal_and_depth_count_only_their_rows():
+    """The fixed-shape step's padded slots and rays without depth weigh nothing: closed
+    forms, and no NaN reaches the gradient from a NaN target."""
+    grads = torch.tensor([[3.0, 4.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, 5.0]])
+    assert eikonal(grads, torch.tensor([True, True, False])).item() == pytest.approx(8.0)
+    assert eikonal(grads, torch.zeros(3, dtype=torch.bool)).item() == 0.0
+    nan = float("nan")
+    depth = torch.tensor([1.0, 2.0], requires_grad=True)
+    assert depth_l1(depth, torch.tensor([nan, nan])).item() == 0.0
+    depth_l1(depth, torch.tensor([1.5, nan])).backward()
+    assert depth.grad.tolist() == [-1.0, 0.0]
