@@ -22,7 +22,7 @@ from envelope.protocols import EVAL_SPLIT, TRAIN_PROTOCOL
 from envelope.scenes.scene import find_scene_folders
 from metrics.run.runner import MethodSpec
 from segment.scene_masks import predicted_scene
-from segment.segmenter import DEFAULT_NAME, Segmenter, resolve_segmenter
+from segment.segmenter import Segmenter, resolve_segmenter
 
 CONFIG_KEY = "masks"
 PREDICTED = "predicted"
@@ -64,9 +64,10 @@ def masks_segmenter(request: MasksRequest) -> Segmenter:
 
 
 def masks_key(segmenter: Segmenter) -> str:
-    """A folder name for a segmenter's masks: ``predicted-default-<weights>`` or
-    ``predicted-<plugin name>`` (file-system safe)."""
-    label = DEFAULT_NAME if segmenter.name == DEFAULT_NAME else Path(segmenter.name).stem
+    """A folder name for a segmenter's masks: ``predicted-<name>-<weights>`` (``<name>``: the
+    segmenter's name, a weights file's stem) or ``predicted-<plugin name>`` (file-system
+    safe)."""
+    label = Path(segmenter.name).stem
     safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in label)
     weights = segmenter.identity.get("weights")
     return f"{PREDICTED}-{safe}" + (f"-{weights[:8]}" if weights else "")
