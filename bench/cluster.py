@@ -44,6 +44,7 @@ from dataset.benchmark_cache import DefaultBenchmark  # noqa: E402
 from dataset.generate import GenerateConfig, generate_preset  # noqa: E402
 from envelope.atomic import write_text_atomic  # noqa: E402
 from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig, ray_session  # noqa: E402
+from envelope.protocols import DEFAULT_PROTOCOLS  # noqa: E402
 from envelope.results import MethodResult  # noqa: E402
 from envelope.scenes.scene import find_scene_folders  # noqa: E402
 from metrics.comparison import compare  # noqa: E402
@@ -205,7 +206,7 @@ def main(argv: list[str] | None = None) -> int:
                             eval_frames=1)
 
     def specs_for(results: Path) -> list[MethodSpec]:
-        return method_specs(methods, ("ideal", "multi"), results, configs={"neural3d": budget})
+        return method_specs(methods, DEFAULT_PROTOCOLS, results, configs={"neural3d": budget})
 
     with tempfile.TemporaryDirectory(prefix="cluster-bench-") as tmp:
         tmp = Path(tmp)
