@@ -53,6 +53,7 @@ def both(clean_scene, tmp_path_factory):
     return _compare(tmp / "truth", tmp), _compare(tmp / "none", tmp)
 
 
+@pytest.mark.slow  # the module's fixture runs two comparisons (about 6 s)
 def test_estimates_without_truth_are_those_of_the_scene_with_truth(both):
     (scored, _), (unscored, _) = both
     assert [o.status for o in unscored.outcomes] == ["ran"] * 2
@@ -62,6 +63,7 @@ def test_estimates_without_truth_are_those_of_the_scene_with_truth(both):
     assert by_key["status"] == "ok" and 0 < by_key["wwr"] < 1 and by_key["facades"] == 4
 
 
+@pytest.mark.slow  # the module's fixture runs two comparisons (about 6 s)
 def test_without_truth_there_is_no_error_table_only_estimates(both):
     (scored, _), (unscored, out) = both
     assert scored.table2 is not None and scored.estimates is None
@@ -77,6 +79,7 @@ def test_without_truth_there_is_no_error_table_only_estimates(both):
     assert json.loads((out / "provenance.json").read_text())["scenes_without_truth"] == ["box"]
 
 
+@pytest.mark.slow  # the module's fixture runs two comparisons (about 6 s)
 def test_the_exports_and_the_report_say_there_is_no_truth(both):
     (_, _), (unscored, out) = both
     facades = (out / EXPORT_FOLDER / "facades.csv").read_text()
@@ -94,6 +97,7 @@ def test_the_exports_and_the_report_say_there_is_no_truth(both):
     assert "Table 2: errors per family" not in page and "WWR error (%)" not in page
 
 
+@pytest.mark.slow  # the module's fixture runs two comparisons (about 6 s)
 def test_the_report_is_rebuilt_from_a_folder_without_truth(both):
     (_, _), (unscored, out) = both
     data = read_report_data(out)
@@ -104,6 +108,7 @@ def test_the_report_is_rebuilt_from_a_folder_without_truth(both):
     assert all(r.wwr_ape is None and r.wwr_true is None for r in data.rows)
 
 
+@pytest.mark.slow  # the module's fixture runs two comparisons (about 6 s)
 def test_a_mixed_folder_is_scored_over_the_scenes_with_truth(clean_scene, tmp_path, both):
     (scored, _), _ = both
     _scene(clean_scene, tmp_path / "mixed", "box", truth=True)
