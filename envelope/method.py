@@ -32,11 +32,12 @@ import sys
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 from importlib.metadata import entry_points
+from pathlib import Path
 from typing import Any, Literal
 
 from envelope.method_input import Input
 from envelope.method_options import Option, field_type
-from envelope.protocols import Protocol
+from envelope.protocols import TRAIN_PROTOCOL, Protocol
 from envelope.results import MethodResult
 
 ENTRY_POINT_GROUP = "envelope_bench.methods"
@@ -52,7 +53,18 @@ RunMethod = Callable[..., MethodResult]
 """``run(scene, protocol, config) -> MethodResult`` for one scene, ``scene`` a
 :class:`~envelope.method_input.MethodInput`; may raise. A method with an ``artefacts``
 folder is called ``run(scene, protocol, config, artefacts_dir=FOLDER)`` and writes its folder
-for the scene (named by the scene) into ``FOLDER``."""
+for the scene and protocol at :func:`artefacts_folder` ``(FOLDER, scene, protocol)``."""
+
+
+def artefacts_folder(artefacts_dir: Path, scene: str, protocol: Protocol) -> Path:
+    """Where a method keeps what one run on ``scene``'s ``protocol`` views made (a trained
+    method's run folder, its mesh): ``<artefacts>/<scene>`` for the orbit (``train``),
+    ``<artefacts>/<protocol>/<scene>`` for every other protocol, so that two captures of one
+    scene never share a folder. The one definition that methods, executors (which move the
+    folder between machines) and the report (which draws the mesh in it) read."""
+    if protocol == TRAIN_PROTOCOL:
+        return artefacts_dir / scene
+    return artefacts_dir / protocol / scene
 
 
 @dataclass(frozen=True)
@@ -86,7 +98,7 @@ class Method:
     ``reserve(config)``: ``(cpus, gpus)`` one run reserves on a cluster node
     (default: 1 CPU, and 1 GPU if ``resources`` is ``"gpu"``); ``artefacts``: the
     folder under the results folder where it keeps one folder per scene (see
-    :data:`RunMethod`); ``mesh_file``: a semantic mesh inside that folder
+    :data:`RunMethod`, :func:`artefacts_folder`); ``mesh_file``: a semantic mesh inside that folder
     (a PLY with per-vertex class ids), drawn by the figures and the HTML report;
     ``heavy``: a robustness study runs it only at each degradation's highest
     severity unless asked otherwise; ``debug_images(scene, protocol, config,

@@ -86,12 +86,12 @@ def read_reconstruction(path: str | Path) -> LabelledMesh:
 def reconstructed_meshes(compare_out: Path,
                          data: Path | None) -> list[tuple[str, Path, Path | None]]:
     """(label, reconstructed mesh, true mesh or None) of each method's run with a mesh;
-    the label is ``scene\nmethod``."""
+    the label is ``scene\nmethod (protocol)``."""
     out = []
     for run in read_mesh_pointers(compare_out):
         if run.mesh.is_file():
             truth = data / run.scene / "mesh.ply" if data is not None else None
-            out.append((f"{run.scene}\n{run.method}", run.mesh,
+            out.append((f"{run.scene}\n{run.method} ({run.protocol})", run.mesh,
                         truth if truth and truth.is_file() else None))
     if not out:
         raise MissingInput("no reconstructed mesh yet (no finished run of a method that "

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
-from envelope.method import Method
+from envelope.method import Method, artefacts_folder
 from envelope.method_input import MethodInput, require_method_input
 from envelope.method_options import Option
 from envelope.protocols import STREET_PROTOCOL, TRAIN_PROTOCOL
@@ -157,20 +157,13 @@ def record_config(budget: Neural3dBudget) -> dict[str, Any]:
     }
 
 
-def run_folder(artefacts_dir: Path, scene: str, protocol: str) -> Path:
-    """Where a training on ``protocol``'s frames of ``scene`` lives: ``<artefacts>/<scene>``
-    for the orbit (``train``), ``<artefacts>/<protocol>/<scene>`` for another capture."""
-    if protocol == TRAIN_PROTOCOL:
-        return artefacts_dir / scene
-    return artefacts_dir / protocol / scene
-
-
 def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
                  artefacts_dir: Path) -> MethodResult:
     """Train for ``budget.steps`` steps (``neural3d.train``, on ``scene`` as read here, on the
-    frames of ``protocol``: ``train``, the orbit, or ``street``) into
-    :func:`run_folder`, then mesh and measure it (``neural3d.extract``) into its
-    ``extract`` folder; the result is returned, not written (the runner writes it).
+    frames of ``protocol``: ``train``, the orbit, or ``street``) into the run folder that
+    :func:`envelope.method.artefacts_folder` names, then mesh and measure it
+    (``neural3d.extract``) into its ``extract`` folder; the result is returned, not written
+    (the runner writes it).
 
     A run folder already there with the same training provenance
     (:func:`neural3d.training.run_folder.training_provenance`: training code, config,
@@ -192,7 +185,7 @@ def run_neural3d(scene: MethodInput, protocol: str, budget: Neural3dBudget, *,
     config = train_config(budget)
     torch.set_num_threads(budget.threads)
     device = torch.device(budget.device)
-    run_dir = run_folder(Path(artefacts_dir), scene_name(scene.root), protocol)
+    run_dir = artefacts_folder(Path(artefacts_dir), scene_name(scene.root), protocol)
     prior = prior_run(run_dir, training_provenance(scene.root, config, device, split=protocol),
                       config.iterations)
     if prior != "finished":

@@ -105,7 +105,8 @@ def _mesh(run: MeshRun, index: int) -> dict[str, str | None]:
         return {"method": run.method, "error": str(exc)}
     n_faces = len(faces)
     vertices, faces, labels = decimate_vertex_clustering(vertices, faces, labels, MAX_MESH_FACES)
-    title = f"{run.method} semantic mesh ({len(faces)} of {n_faces} faces)"
+    title = (f"{run.method} semantic mesh, {run.protocol} views "
+             f"({len(faces)} of {n_faces} faces)")
     return {"method": run.method, "error": None,
             "chart_id": f"mesh-{run.scene}" + (f"-{index}" if index else ""),
             "figure_json": mesh_figure_json(vertices, faces, labels, title)}

@@ -41,6 +41,7 @@ from envelope.executors.ray_tasks import (
     ray_session,
     run_tasks,
 )
+from envelope.method import artefacts_folder
 from metrics.run.runner import Execute, Job, Outcome, RunOne, execute_local
 
 
@@ -115,9 +116,10 @@ def execute_ray(
 ) -> Iterator[tuple[int, Outcome]]:
     """Run every job as a Ray task; yield ``(index, outcome)`` as tasks finish.
 
-    A job's artefacts folder is unpacked into ``spec.artefacts_dir / <scene>``
-    (replacing the one there) before its outcome is yielded. Leaving the
-    iteration early (Ctrl-C) cancels the tasks not yet collected.
+    A job's artefacts folder is unpacked where the method keeps it
+    (:func:`envelope.method.artefacts_folder` under ``spec.artefacts_dir``, replacing the one
+    there) before its outcome is yielded. Leaving the iteration early (Ctrl-C) cancels the
+    tasks not yet collected.
     """
     if not jobs:
         return
@@ -136,7 +138,8 @@ def execute_ray(
                 continue
             outcome, artefacts = value
             if artefacts is not None and job.spec.artefacts_dir is not None:
-                with atomic_directory(job.spec.artefacts_dir / job.scene_dir.name) as tmp:
+                with atomic_directory(artefacts_folder(job.spec.artefacts_dir,
+                                                       job.scene_dir.name, job.protocol)) as tmp:
                     unpack_folder(artefacts, tmp)
             yield i, outcome
 
@@ -148,5 +151,6 @@ def _run_packed(scene_tar: bytes, job: Job, run_one: RunOne) -> tuple[Outcome, b
         scene_dir = unpack_folder(scene_tar, Path(tmp) / "scene" / job.scene_dir.name)
         artefacts = Path(tmp) / "artefacts" if job.spec.artefacts_dir is not None else None
         outcome = run_one(replace(job, scene_dir=scene_dir, artefacts_dir=artefacts))
-        kept = artefacts / scene_dir.name if artefacts is not None else None
+        kept = (artefacts_folder(artefacts, scene_dir.name, job.protocol)
+                if artefacts is not None else None)
         return outcome, pack_folder(kept) if kept is not None and kept.is_dir() else None

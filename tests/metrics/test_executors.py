@@ -21,6 +21,7 @@ from pathlib import Path
 import pytest
 
 from envelope.executors.ray_tasks import LOCAL_ONLY_ENV, RayConfig
+from envelope.method import artefacts_folder
 from envelope.results import read_result
 from envelope.scenes.scene import find_scene_folders
 from metrics.compare import main
@@ -167,7 +168,8 @@ def test_retries_are_bounded_and_an_input_failure_is_not_retried(
 @pytest.mark.slow
 def test_a_scene_reaches_the_worker_without_a_shared_folder(local_ray, tiny_benchmark, tmp_path):
     """The method removes the driver's scene folder before reading its own copy, and writes
-    an artefacts folder that comes back to the driver (as neural3d's run folder does)."""
+    an artefacts folder that comes back to the driver (as neural3d's run folder does), to the
+    place :func:`artefacts_folder` names for the job's protocol (here not the orbit's)."""
     driver_scene = tmp_path / "data" / "tiny_skyscraper"
     shutil.copytree(tiny_benchmark / "tiny_skyscraper", driver_scene)
     base = method_specs(("2D-S",), ("ideal",), tmp_path)[0]
@@ -176,7 +178,7 @@ def test_a_scene_reaches_the_worker_without_a_shared_folder(local_ray, tiny_benc
     def run(scene_dir, protocol, artefacts_dir=tmp_path / "runs"):
         assert scene_dir != driver_scene and artefacts_dir != tmp_path / "runs"
         shutil.rmtree(driver_scene)  # from here on only the worker's copy exists
-        extract = artefacts_dir / scene_dir.name / "extract"
+        extract = artefacts_folder(artefacts_dir, scene_dir.name, protocol) / "extract"
         extract.mkdir(parents=True)
         (extract / "mesh.ply").write_bytes(b"ply\n" + scene_dir.name.encode())
         return base.run(scene_dir, protocol)
@@ -188,7 +190,7 @@ def test_a_scene_reaches_the_worker_without_a_shared_folder(local_ray, tiny_benc
     assert outcome.status == "ran", outcome.reason
     assert replace(outcome.result, wall_time_s=0.0, provenance=None) == replace(
         expected, wall_time_s=0.0)
-    mesh = tmp_path / "runs" / "tiny_skyscraper" / "extract" / "mesh.ply"
+    mesh = tmp_path / "runs" / "ideal" / "tiny_skyscraper" / "extract" / "mesh.ply"
     assert mesh.read_bytes() == b"ply\ntiny_skyscraper"
 
 

@@ -130,14 +130,14 @@ def test_a_street_capture_trains_its_own_run_with_its_own_protocol(box_building,
     """neural3d on the ``street`` protocol trains on the street frames alone, in its own run
     folder (``<artefacts>/street/<scene>``), keyed apart from an orbit training, and its
     result names the protocol; a scene with street frames only has no orbit to train on."""
+    from envelope.method import artefacts_folder
     from neural3d.field.trained import load_trained_field
-    from neural3d.method import run_folder
 
     street = write_ring_scene(box_building, tmp_path / "street_box", size_px=24, n_train=8,
                               n_eval=2, split="street")
     read = read_method_input(street)
     result = run_neural3d(read, "street", BUDGET, artefacts_dir=tmp_path / "runs")
-    run = run_folder(tmp_path / "runs", scene_name(street), "street")
+    run = artefacts_folder(tmp_path / "runs", scene_name(street), "street")
     assert run == tmp_path / "runs" / "street" / scene_name(street)
     record = json.loads((run / "run.json").read_text())
     assert (record["split"], record["train_frames"]) == ("street", 8)
