@@ -20,6 +20,7 @@ from typing import Any
 
 from dataset.importers.import_config import ImportConfig
 from dataset.importers.mesh.building_file import BuildingFileOptions
+from dataset.importers.photos.gps_fit import MIN_FIXES, MIN_SPREAD_M
 from dataset.importers.photos.metric_frame import KnownDistance, ScaleHint
 from dataset.importers.photos.source import PhotosOptions
 from dataset.importers.source import NoOptions, Source, pick_source
@@ -87,6 +88,10 @@ def add_import_arguments(parser: argparse.ArgumentParser) -> None:
                              "names) were taken from")
     photos.add_argument("--known-height", type=float, metavar="METRES",
                         help="the building's height in metres, ground to top")
+    photos.add_argument("--gps", action="store_true",
+                        help="the scale and true north from the photos' EXIF GPS positions "
+                             f"(at least {MIN_FIXES} photos with a fix, spread {MIN_SPREAD_M:g} m "
+                             "or more about their mean; +y becomes north, x east)")
 
 
 def chosen_source(args: argparse.Namespace, sources: Sequence[Source]) -> tuple[Source, str]:
@@ -121,13 +126,14 @@ def source_options(source: Source, args: argparse.Namespace, *, building_id: str
                                    ifc_classes=args.ifc_classes, progress=progress)
     if args.ifc_classes is not None:
         raise ValueError(f"--ifc-classes goes with --ifc, not with {source.flag}")
-    scale_given = args.known_distance is not None or args.known_height is not None
+    scale_given = (args.known_distance is not None or args.known_height is not None
+                   or args.gps)
     if source.options_type is PhotosOptions:
         return PhotosOptions(photos_scale_from_args(args) if scale_given else None,
                              progress=progress)
     if scale_given:
-        raise ValueError(f"--known-distance and --known-height go with --photos, not with "
-                         f"{source.flag}")
+        raise ValueError(f"--known-distance, --known-height and --gps go with --photos, not "
+                         f"with {source.flag}")
     if source.options_type is NoOptions:
         return NoOptions()
     raise ValueError(f"source {source.name} reads {source.options_type.__name__}, which the "
@@ -148,7 +154,7 @@ def import_config_from_args(args: argparse.Namespace) -> ImportConfig:
 
 
 def photos_scale_from_args(args: argparse.Namespace) -> ScaleHint:
-    """The :class:`ScaleHint` of ``--known-distance`` / ``--known-height``.
+    """The :class:`ScaleHint` of ``--known-distance`` / ``--known-height`` / ``--gps``.
 
     Raises
     ------
@@ -163,7 +169,7 @@ def photos_scale_from_args(args: argparse.Namespace) -> ScaleHint:
         except ValueError:
             raise ValueError(f"--known-distance PHOTO_A PHOTO_B METRES: {metres!r} is not a "
                              "number of metres") from None
-    return ScaleHint(known, args.known_height)
+    return ScaleHint(known, args.known_height, gps=args.gps)
 
 
 def _by_flag(sources: Sequence[Source]) -> dict[str, list[Source]]:

@@ -11,10 +11,13 @@ knows (docs/importing.md, section 9, says what is assumed).
   made perpendicular to their x axes (exact only for level cameras).
 - **Scale** from one thing the user knows: the distance between two cameras (two photos'
   names), or the building's height, taken as the span of the sparse points along up from
-  their :data:`GROUND_PERCENTILE` to their :data:`TOP_PERCENTILE`. Nothing known: refused.
+  their :data:`GROUND_PERCENTILE` to their :data:`TOP_PERCENTILE`; or from the photos' EXIF
+  GPS positions (:mod:`dataset.importers.photos.gps_fit`), which give true north too.
+  Nothing known: refused.
 - **Where**: with sparse points, the ground (z = 0) at their :data:`GROUND_PERCENTILE` along
   up and the origin above their median; without (a nerfstudio file), the input's origin.
-- **North** is unknown: the world's +y is the way the first photo looks (level).
+- **North**: with GPS, the world's +y is true north and +x east; otherwise north is
+  unknown and +y is the way the first photo looks (level).
 """
 
 from __future__ import annotations
@@ -24,6 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dataset.importers.photos.gps import GpsFix
+from dataset.importers.photos.gps_frame import gps_frame
+
 MIN_HEADING_SPREAD = 0.01
 """The second-least eigenvalue of sum x xᵀ per camera below which the photos face one way
 (their x axes within about 6 degrees: sin² 6° ≈ 0.01)."""
@@ -31,9 +37,9 @@ GROUND_PERCENTILE = 1.0
 TOP_PERCENTILE = 99.0
 """The sparse points' percentiles along up taken for the ground and the building's top (a
 few stray points below the ground or above the roof change nothing)."""
-SCALE_OPTIONS = "--known-distance PHOTO_A PHOTO_B METRES or --known-height METRES"
-NO_SCALE = (f"photos carry no scale: say what you know, with {SCALE_OPTIONS} "
-            "(docs/importing.md, section 9)")
+SCALE_OPTIONS = "--known-distance PHOTO_A PHOTO_B METRES, --known-height METRES or --gps"
+NO_SCALE = (f"photos carry no scale: say what you know, with {SCALE_OPTIONS} (the photos' "
+            "EXIF GPS positions, which give north too; docs/importing.md, section 9)")
 
 
 @dataclass(frozen=True)
@@ -47,18 +53,22 @@ class KnownDistance:
 
 @dataclass(frozen=True)
 class ScaleHint:
-    """What the user knows of the scale: one of a known distance between two cameras, or
-    the building's height in metres."""
+    """What the user knows of the scale: one of a known distance between two cameras, the
+    building's height in metres, or ``gps``: the photos' EXIF GPS positions."""
 
     known_distance: KnownDistance | None = None
     known_height_m: float | None = None
+    gps: bool = False
 
     def __post_init__(self) -> None:
-        given = (self.known_distance is not None) + (self.known_height_m is not None)
+        given = ((self.known_distance is not None) + (self.known_height_m is not None)
+                 + self.gps)
         if given == 0:
             raise ValueError(NO_SCALE)
-        if given == 2:
-            raise ValueError(f"give one scale, not both: {SCALE_OPTIONS}")
+        if given > 1:
+            raise ValueError(f"give one scale, not {given}: {SCALE_OPTIONS}")
+        if self.gps:
+            return
         value = (self.known_distance.metres if self.known_distance is not None
                  else self.known_height_m)
         if not (np.isfinite(value) and value > 0):
@@ -109,7 +119,9 @@ def up_from_cameras(world_from_camera: np.ndarray) -> tuple[np.ndarray, str]:
 
 
 def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
-                      points: np.ndarray | None, hint: ScaleHint) -> tuple[Similarity, dict]:
+                      points: np.ndarray | None, hint: ScaleHint,
+                      gps_fixes: Sequence[GpsFix | None] | None = None
+                      ) -> tuple[Similarity, dict]:
     """The similarity from the input frame to the world, and a record of what it assumed.
 
     Parameters
@@ -117,12 +129,15 @@ def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
     world_from_camera : (N, 4, 4) OpenGL camera-to-world poses in the input frame
     names : the N photos' names
     points : (M, 3) sparse points in the input frame, or ``None``
+    gps_fixes : the N photos' EXIF GPS fixes (``None`` where a photo has none); needed
+        with ``hint.gps``
 
     Raises
     ------
     ValueError
         A known distance names a photo that has no pose, or two cameras at one place; a
-        known height without sparse points.
+        known height without sparse points; GPS fixes too few, too close together or
+        disagreeing (:func:`dataset.importers.photos.gps_fit.fit_gps`).
     """
     poses = np.asarray(world_from_camera, dtype=np.float64)
     up, up_how = up_from_cameras(poses)
@@ -132,7 +147,15 @@ def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
                          "photo taken level first")
     right /= np.linalg.norm(right)
     rotation = np.stack([right, np.cross(up, right), up])
-    scale, scale_how = _scale(poses, list(names), points, up, hint)
+    if hint.gps:
+        if gps_fixes is None or len(gps_fixes) != len(poses):
+            raise ValueError("--gps needs each posed photo's GPS fix (None where it has none)")
+        gps = gps_frame(poses, names, rotation, gps_fixes)
+        scale, rotation = gps.scale, gps.turn_z @ rotation
+        scale_how = (f"GPS: the EXIF positions of {int(gps.fit.kept.sum())} photos, "
+                     "horizontal similarity fit (altitude not used)")
+    else:
+        scale, scale_how = _scale(poses, list(names), points, up, hint)
     if points is None or len(points) == 0:
         translation = np.zeros(3)
         where = "the input's origin (no sparse points)"
@@ -143,7 +166,15 @@ def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
         where = (f"ground at the sparse points' {GROUND_PERCENTILE:g}th percentile along up, "
                  "origin above their median")
     record = {"up": up_how, "scale": scale_how, "origin": where,
-              "north": f"unknown: +y is the way the first photo ({names[0]}) looks"}
+              "scale_source": ("gps" if hint.gps else "known_distance"
+                               if hint.known_distance is not None else "known_height"),
+              "north_known": hint.gps,
+              "north": ("true north: +y points north, +x east (from the GPS positions)"
+                        if hint.gps else
+                        f"unknown: +y is the way the first photo ({names[0]}) looks")}
+    if hint.gps:
+        record["north_deg"] = 0.0  # envelope.orientation: +y is true north
+        record["gps"] = gps.record(translation[:2])
     return Similarity(scale, rotation, translation), record
 
 

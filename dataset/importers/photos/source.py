@@ -28,6 +28,8 @@ from dataset.importers.photos.existing import (
     read_nerfstudio,
     transforms_file,
 )
+from dataset.importers.photos.gps import read_gps_fix
+from dataset.importers.photos.gps_frame import check_photo_fixes
 from dataset.importers.photos.metric_frame import NO_SCALE, ScaleHint, metric_similarity
 from dataset.importers.photos.photo_folder import PHOTO_SUFFIXES, Photo, list_photos
 from dataset.importers.photos.posed import (
@@ -66,7 +68,8 @@ def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, .
     ------
     ValueError
         No scale given, or (a folder of photos) as
-        :func:`dataset.importers.photos.photo_folder.list_photos`.
+        :func:`dataset.importers.photos.photo_folder.list_photos`, a known distance naming
+        no photo, or (``--gps``) too few GPS fixes or fixes too close together.
     """
     path = Path(path)
     if options.scale is None:
@@ -85,6 +88,8 @@ def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, .
     if missing:
         raise ValueError(f"--known-distance names {', '.join(missing)}, which is not a photo "
                          f"of {path} (give the photos' file names, e.g. {photos[0].name})")
+    if options.scale.gps:
+        check_photo_fixes([read_gps_fix(p.path) for p in photos])
     return (SceneEntry(path.resolve().name, partial(_write, partial(_structure_from_motion,
                                                                     photos, options.sfm),
                                                     path, options)),)
@@ -134,7 +139,8 @@ def _write(read: Callable[[Path], PosedPhotos], path: Path, options: PhotosOptio
         raise ValueError(f"{path}: two images share a file name; rename them")
     similarity, frame_record = metric_similarity(
         np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
-        options.scale)
+        options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
+        if options.scale.gps else None)
     (out_dir / "images").mkdir()
     frames = []
     for photo in tqdm(posed.photos, desc="photos", unit="photo", disable=not options.progress):
@@ -156,6 +162,6 @@ PHOTOS_SOURCE = Source(
     name="photos", flag="--photos",
     help="a folder of JPEG or PNG photos of one building (poses from structure from motion), "
          "a COLMAP project (sparse/0 and images/) or a nerfstudio transforms.json; needs "
-         "--known-distance or --known-height for the scale",
+         "--known-distance, --known-height or --gps for the scale",
     detect=detect_photos, read=read_photos, options_type=PhotosOptions,
 )
