@@ -14,6 +14,7 @@ from fractions import Fraction
 import cv2
 import numpy as np
 import pytest
+from paths import REPO_ROOT
 from PIL import ExifTags, Image
 from PIL.TiffImagePlugin import IFDRational
 from scipy.spatial.transform import Rotation
@@ -39,7 +40,6 @@ from dataset.importers.photos.gps_fit import (
 from dataset.importers.photos.metric_frame import ScaleHint, metric_similarity
 from envelope.camera import Intrinsics, look_at
 from envelope.scenes.scene import read_method_input
-from paths import REPO_ROOT
 
 EXACT = 1e-9
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "photos_gps" / "IMG_20180725_163423-128px.jpg"
