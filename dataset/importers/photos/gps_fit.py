@@ -125,6 +125,9 @@ def fit_gps(source_xy: np.ndarray, east_north: np.ndarray) -> GpsFit:
     ds = source[second] - source[first]
     usable = np.abs(ds) > 1e-12 * max(1.0, float(np.abs(source).max()))
     first, second, ds = first[usable], second[usable], ds[usable]
+    if len(ds) == 0:
+        raise ValueError("--gps: the cameras with a GPS position were all at one place in "
+                         f"structure from motion: {FALLBACK_OPTIONS}")
     a = (target[second] - target[first]) / ds
     b = target[first] - a * source[first]
     cost = np.minimum(np.abs(a[:, None] * source[None] + b[:, None] - target[None]) ** 2,

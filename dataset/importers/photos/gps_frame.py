@@ -35,7 +35,8 @@ from dataset.importers.photos.gps_fit import (
 class GpsFrame:
     """The fit of the levelled camera centres onto their GPS metres: ``scale``, ``turn_z``
     ((3, 3), about z, from the levelled frame to east, north, up), the local ``origin`` of
-    the metres, and the photos' ``names`` and per-photo fixes behind it."""
+    the metres, the ``fit`` (over the photos with a fix), the posed photos' ``names``, the
+    indices of those ``with_fix`` (the fit's order) and the ``compass`` comparison."""
 
     scale: float
     turn_z: np.ndarray
