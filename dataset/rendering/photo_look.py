@@ -101,6 +101,9 @@ def weathering(s: np.ndarray, v: np.ndarray, seed: int, footprint_m: np.ndarray)
     w += 0.16 * detail(footprint_m, 0.25) * (value_noise(s / 0.25, v / 0.25, seed + 13) - 0.5)
     w += 0.12 * detail(footprint_m, 0.07) * (value_noise(s / 0.07, v / 0.07, seed + 14) - 0.5)
     w += 0.08 * detail(footprint_m, 0.02) * (value_noise(s / 0.02, v / 0.02, seed + 15) - 0.5)
+    for scale_m, strength, k in ((2.0, 0.22, 17), (0.5, 0.3, 18), (0.15, 0.3, 19)):
+        w *= 1.0 - strength * detail(footprint_m, scale_m / 4) * _blotches(s / scale_m,
+                                                                          v / scale_m, seed + k)
     streak = np.clip(value_noise(s / 0.35, v / 6.0, seed + 16) - 0.55, 0.0, None)
     w *= 1.0 - 0.9 * streak
     w *= 1.0 - 0.18 * np.exp(-np.clip(v, 0.0, None) / 0.4)
@@ -216,6 +219,7 @@ def ground_albedo(x: np.ndarray, y: np.ndarray, bounds_m: np.ndarray, look: Look
     patches += 0.3 * detail(footprint_m, 0.3) * (value_noise(x / 0.3, y / 0.3, seed + 56) - 0.5)
     cracks = np.abs(value_noise(x / 0.8, y / 0.8, seed + 57) - 0.5) < 0.02
     patches -= 0.4 * cracks * detail(footprint_m, 0.05)
+    patches += 0.35 * detail(footprint_m, 0.2) * _blotches(x / 0.8, y / 0.8, seed + 62)
     road = materials.asphalt_rgb * (1.0 + patches)[:, None]
     across = out_m - PAVING_WIDTH_M - KERB_WIDTH_M
     edge_line = (across > 0.3) & (across < 0.45)
@@ -228,10 +232,17 @@ def ground_albedo(x: np.ndarray, y: np.ndarray, bounds_m: np.ndarray, look: Look
     tufts = 0.5 * (value_noise(x / 0.8, y / 0.8, seed + 59) - 0.5)
     tufts += 0.5 * detail(footprint_m, 0.25) * (value_noise(x / 0.25, y / 0.25, seed + 55) - 0.5)
     tufts += 0.4 * detail(footprint_m, 0.08) * (value_noise(x / 0.08, y / 0.08, seed + 60) - 0.5)
-    grass *= (1.0 + tufts)[:, None]
+    grass *= (1.0 + tufts)[:, None] * (1.0 - 0.3 * detail(footprint_m, 0.1) * _blotches(
+        x / 0.4, y / 0.4, seed + 61))[:, None]
     zone = np.digitize(out_m, np.cumsum([PAVING_WIDTH_M, KERB_WIDTH_M, ROAD_WIDTH_M]))
     albedo = np.choose(zone[:, None], [paving, kerb, road, grass])
     return albedo * grain[:, None]
+
+
+def _blotches(x: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray:
+    """(N,) irregular patches in [0, 1] with edges a tenth of the lattice wide (stains,
+    repairs): value noise above a threshold, about a third of the area."""
+    return np.clip((value_noise(x, y, seed) - 0.55) / 0.05, 0.0, 1.0)
 
 
 def _blocks(s: np.ndarray, v: np.ndarray, rgb: np.ndarray, joint_rgb: np.ndarray, seed: int,

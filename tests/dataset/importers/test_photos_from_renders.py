@@ -1,0 +1,40 @@
+"""dataset.importers.photos end to end on the project's own renders: a procedural building
+rendered in the photo look (RgbConfig(look="photo")), stripped to its RGB images
+(dataset.importers.photos.stripped_renders), posed by structure from motion with one known
+distance, and compared with the true cameras (issue 47: >= 90 % of the views posed, scale
+within 2 %). bench/photos_from_renders.py runs the same at 1024 px on more buildings
+(docs/measurements/photo-look.md)."""
+
+import numpy as np
+import pytest
+
+from dataset.generate import generate_preset
+from dataset.importers.photos.stripped_renders import pose_stripped_renders
+from dataset.rendering.orbit_views import OrbitConfig
+from dataset.rendering.shading import RgbConfig
+from dataset.scenes.scene_writer import GenerateConfig
+
+MIN_POSED_FRACTION = 0.9
+SCALE_TOLERANCE = 0.02
+"""The issue's bar for the stripped renders."""
+CONFIG = GenerateConfig(resolution=512, views=24, ideal=False, multi=False,
+                        orbit=OrbitConfig(elevation_deg=(15.0, 35.0)),
+                        rgb=RgbConfig(look="photo"))
+"""A small capture: 24 orbit views of 512 px, 15-35 degrees above the building's centre (a
+drone circling it; the default band, -10 to 65 degrees, spreads 24 views too thin)."""
+# Measured (2026-11-29, pycolmap 4.2.1): 24 of 24 posed, scale 0.07 % off, median rotation
+# 0.20 degrees, median position 0.07 m (orbit of about 30 m); room for another machine.
+ROTATION_TOLERANCE_DEG = 1.0
+POSITION_TOLERANCE_M = 0.5
+
+
+@pytest.mark.slow
+def test_photo_look_renders_are_posed_from_the_images_alone(tmp_path):
+    scene, = generate_preset("tiny", tmp_path / "scenes", CONFIG, buildings=["tiny_l_shaped"],
+                             progress=False)
+    run = pose_stripped_renders(scene, tmp_path / "work", ("train", "eval"))
+    assert run.failure == ""
+    assert run.posed_fraction >= MIN_POSED_FRACTION, run.posed
+    assert run.errors.scale_error < SCALE_TOLERANCE
+    assert np.median(run.errors.rotation_deg) < ROTATION_TOLERANCE_DEG
+    assert np.median(run.errors.position_m) < POSITION_TOLERANCE_M
