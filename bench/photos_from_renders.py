@@ -1,11 +1,13 @@
 """Structure from motion on renders stripped of their poses; prints a Markdown table.
 
     python bench/photos_from_renders.py [--preset P --building B ...] [--views N]
-        [--resolution PX] [--look photo|plain] [--street] [--work DIR]
+        [--resolution PX] [--look photo|plain] [--paths orbit street] [--context]
+        [--work DIR]
 
 Renders each building (``--preset``/``--building`` pairs in order; default the tiny preset's
-``tiny_l_shaped``) with ``--views`` orbit views (and, with ``--street``, its street frames)
-in the chosen look, copies only the RGB images into a folder of photos (JPEG with the EXIF
+``tiny_l_shaped``) with ``--views`` orbit views and, with ``--paths ... street``, its street
+frames (``--context``: with the neighbours the source gives, as ``dataset.generate
+--context``) in the chosen look, copies only the RGB images into a folder of photos (JPEG with the EXIF
 a camera writes, :mod:`dataset.importers.photos.stripped_renders`), runs the photos source on
 them with ``--known-distance`` between the first photo and the one farthest from it (the
 distance taken from the true poses: what a user pacing it would give), and compares the
@@ -35,14 +37,15 @@ from dataset.rendering.street_views import StreetConfig  # noqa: E402
 from dataset.scenes.scene_writer import GenerateConfig  # noqa: E402
 from envelope.protocols import EVAL_SPLIT, STREET_SPLIT, TRAIN_PROTOCOL  # noqa: E402
 
-COLUMNS = ("building", "path", "look", "views", "posed", "rotation deg (median / max)",
+COLUMNS = ("building", "path", "context", "look", "views", "posed", "rotation deg (median / max)",
            "position m (median / max)", "scale error %", "up deg", "SfM s")
 
 
-def run_row(scene_dir: Path, work: Path, path: str, look: str, sfm: SfmConfig) -> list[str]:
+def run_row(scene_dir: Path, work: Path, path: str, context: bool, look: str,
+            sfm: SfmConfig) -> list[str]:
     splits = (STREET_SPLIT,) if path == "street" else (TRAIN_PROTOCOL, EVAL_SPLIT)
     run = pose_stripped_renders(scene_dir, work / f"{scene_dir.name}-{path}", splits, sfm=sfm)
-    head = [scene_dir.name, path, look, str(run.views),
+    head = [scene_dir.name, path, "yes" if context else "no", look, str(run.views),
             f"{run.posed} ({100 * run.posed_fraction:.0f} %)"]
     e = run.errors
     if e is None:
@@ -60,7 +63,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--views", type=int, default=40, help="orbit views (default 40)")
     p.add_argument("--resolution", type=int, default=1024, help="image size (default 1024)")
     p.add_argument("--look", choices=("photo", "plain"), default="photo")
-    p.add_argument("--street", action="store_true", help="also pose the street frames")
+    p.add_argument("--paths", nargs="+", choices=("orbit", "street"), default=["orbit"],
+                   help="captures to pose, each on its own (default: orbit)")
+    p.add_argument("--context", action="store_true", help="render the neighbours too")
     p.add_argument("--work", type=Path, help="keep renders and models here (default: a "
                    "temporary folder)")
     args = p.parse_args(argv)
@@ -68,7 +73,8 @@ def main(argv: list[str] | None = None) -> int:
     if len(presets) != len(buildings):
         p.error("give one --preset per --building")
     config = GenerateConfig(resolution=args.resolution, views=args.views, ideal=False,
-                            multi=False, street=StreetConfig() if args.street else None,
+                            multi=False, context=args.context,
+                            street=StreetConfig() if "street" in args.paths else None,
                             rgb=RgbConfig(look=args.look))
     sfm = SfmConfig()
     rows = []
@@ -80,8 +86,8 @@ def main(argv: list[str] | None = None) -> int:
                                          progress=False)
             print(f"{building}: rendered in {time.perf_counter() - start:.0f} s",
                   file=sys.stderr)
-            for path in ("orbit", "street") if args.street else ("orbit",):
-                rows.append(run_row(scene_dir, work, path, args.look, sfm))
+            for path in args.paths:
+                rows.append(run_row(scene_dir, work, path, args.context, args.look, sfm))
     print(markdown_table(f"Photos source on stripped renders ({args.resolution} px)",
                          COLUMNS, rows))
     return 0
