@@ -6,8 +6,8 @@ zone; roofs tiles with moss, or a membrane when flat; window frames weathered; g
 blind or curtain per window and reflections of the ground; the ground is the plane z = 0
 (paving round the building, a kerb, a road with markings, then grass) lit by the sun and
 shaded by the building. Every pattern is a pure function of world coordinates (a wall's own
-(along, height) coordinates, the ground's x, y) and the look's seed, so it stays put between
-views; features smaller than a pixel's footprint fade to their mean (no aliasing, which would
+(along, height) coordinates, shifted per plane so that no two walls look alike, the ground's
+x, y) and the look's seed, so it stays put between views; features smaller than a pixel's footprint fade to their mean (no aliasing, which would
 differ from view to view). Only the RGB image changes: labels, depth and facade ids are the
 same with either look.
 """
@@ -65,6 +65,19 @@ def photo_materials(look: Look) -> PhotoMaterials:
         earth_rgb=(np.array([0.45, 0.38, 0.30]) * rng.uniform(0.8, 1.1)) ** 2.2,
         blind_rgb=(np.array([0.85, 0.82, 0.74]) * rng.uniform(0.6, 1.0)) ** 2.2,
     )
+
+
+def plane_offset_m(points_m: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """(N,) shift (m) of the along-wall texture coordinate, constant on each plane and
+    different from plane to plane (by the normal's heading and the plane's distance from the
+    origin), so that two walls never show the same pattern: structure from motion would
+    take one for the other. Inputs (N, 3): points and unit normals."""
+    horizontal = normals[:, :2]
+    length = np.linalg.norm(horizontal, axis=1)
+    heading = np.divide(horizontal, length[:, None], out=np.zeros_like(horizontal),
+                        where=length[:, None] > 0)
+    distance_m = np.einsum("ij,ij->i", points_m, normals)
+    return 1013.7 * heading[:, 0] + 577.3 * heading[:, 1] + 13.1 * distance_m
 
 
 def surface_albedo(label: np.ndarray, facade: np.ndarray, s: np.ndarray, v: np.ndarray,

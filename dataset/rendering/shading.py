@@ -240,6 +240,8 @@ def shade(
     cos_i = np.clip(-np.einsum("ij,ij->i", d, n_front), 0.15, 1.0)
     footprint_m = t[hit] * np.linalg.norm(dirs[hit], axis=1) * pixel_angle_rad / cos_i
     s, v = surface_coords(p, n_front)
+    if photo is not None:  # no two walls alike: matching must not confuse them
+        s = s + photo_look.plane_offset_m(p, n_front)
     albedo = _albedo(label, facade, s, v, look, footprint_m)
     textured = np.zeros(len(hit), dtype=bool)
     if textures is not None:

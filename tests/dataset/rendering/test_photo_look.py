@@ -4,7 +4,7 @@ default."""
 import numpy as np
 import pytest
 
-from dataset.rendering.photo_look import ground_albedo, photo_materials
+from dataset.rendering.photo_look import ground_albedo, photo_materials, plane_offset_m
 from dataset.rendering.render import Raycaster, RgbConfig, render_view
 from dataset.rendering.shading import sample_look, shade
 from dataset.scenes.scene_writer import GenerateConfig, generator_record
@@ -85,3 +85,16 @@ def test_the_look_is_off_by_default_and_recorded_when_on():
     assert photo["look"] == "photo"
     with pytest.raises(ValueError, match="look must be 'plain' or 'photo'"):
         RgbConfig(look="glossy")
+
+
+def test_walls_are_told_apart_by_their_texture_offset():
+    # Constant on a plane (any point of the -y wall), different on every other wall.
+    wall = np.array([[x, -6.0, z] for x in (-8.0, 0.0, 7.5) for z in (0.5, 8.0)])
+    normals = np.tile([0.0, -1.0, 0.0], (len(wall), 1))
+    offsets = plane_offset_m(wall, normals)
+    np.testing.assert_allclose(offsets, offsets[0], atol=1e-9)
+    others = plane_offset_m(np.array([[0.0, 6.0, 1.0], [10.0, 0.0, 1.0], [-10.0, 0.0, 1.0],
+                                      [0.0, -9.0, 1.0]]),
+                            np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0],
+                                      [0.0, -1.0, 0.0]]))
+    assert np.abs(others - offsets[0]).min() > 10.0
