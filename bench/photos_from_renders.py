@@ -7,12 +7,13 @@
 Renders each building (``--preset``/``--building`` pairs in order; default the tiny preset's
 ``tiny_l_shaped``) with ``--views`` orbit views and, with ``--paths ... street``, its street
 frames (``--context``: with the neighbours the source gives, as ``dataset.generate
---context``) in the chosen look, copies only the RGB images into a folder of photos (JPEG with the EXIF
-a camera writes, :mod:`dataset.importers.photos.stripped_renders`), runs the photos source on
-them with ``--known-distance`` between the first photo and the one farthest from it (the
-distance taken from the true poses: what a user pacing it would give), and compares the
-recovered cameras with the true ones after the best similarity: share of views posed,
-rotation error (deg), camera position error (m), scale error (%), the up axis's tilt (deg).
+--context``) in the chosen look, copies only the RGB images into a folder of photos (JPEG
+with the EXIF a camera writes, :mod:`dataset.importers.photos.stripped_renders`), runs the
+photos source on them with ``--known-distance`` between the first photo and the one
+farthest from it (the distance taken from the true poses: what a user pacing it would give),
+and compares the recovered cameras with the true ones after the best similarity: share of
+views posed, rotation error (deg), camera position error (m), scale error (%), the up axis's
+tilt (deg).
 Orbit (train + eval frames) and street frames are posed separately (different lenses).
 """
 

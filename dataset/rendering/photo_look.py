@@ -7,9 +7,9 @@ blind or curtain per window and reflections of the ground; the ground is the pla
 (paving round the building, a kerb, a road with markings, then grass) lit by the sun and
 shaded by the building. Every pattern is a pure function of world coordinates (a wall's own
 (along, height) coordinates, shifted per plane so that no two walls look alike, the ground's
-x, y) and the look's seed, so it stays put between views; features smaller than a pixel's footprint fade to their mean (no aliasing, which would
-differ from view to view). Only the RGB image changes: labels, depth and facade ids are the
-same with either look.
+x, y) and the look's seed, so it stays put between views; features smaller than a pixel's
+footprint fade to their mean (no aliasing, which would differ from view to view). Only the
+RGB image changes: labels, depth and facade ids are the same with either look.
 """
 
 from __future__ import annotations

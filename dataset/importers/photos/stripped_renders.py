@@ -99,9 +99,12 @@ def known_pair(truth: dict[str, np.ndarray]) -> KnownDistance:
 
 
 def pose_stripped_renders(scene_dir: str | Path, work_dir: str | Path, splits: Sequence[str],
-                          *, sfm: SfmConfig = SfmConfig()) -> StrippedRun:
+                          *, sfm: SfmConfig | None = None) -> StrippedRun:
     """Strip the renders of ``splits`` into ``work_dir / <scene name>``, pose them with the
-    photos source (scene written to ``work_dir / "posed"``) and compare with the truth."""
+    photos source (``sfm``: its structure-from-motion settings, default
+    :class:`~dataset.importers.photos.sfm.SfmConfig`; scene written to
+    ``work_dir / "posed"``) and compare with the truth."""
+    sfm = SfmConfig() if sfm is None else sfm
     scene_dir, work_dir = Path(scene_dir), Path(work_dir)
     photos_dir = work_dir / scene_dir.name
     truth = strip_renders(scene_dir, photos_dir, splits)
