@@ -186,3 +186,10 @@ def test_scene_made_by_other_code_is_rerendered_with_the_reason(tmp_path, monkey
     assert logged == ["box_a: code of dataset changed; re-rendering"]
     assert scene_changes(tmp_path / "box_a", SMALL, scene_seed(0, 1),
                          {"preset": "boxes", "recipe": "box_a"}) == []
+
+
+def test_preset_run_of_named_buildings_refuses_an_unknown_name(tmp_path):
+    with pytest.raises(ValueError, match="preset tiny has no building nope .*tiny_l_shaped"):
+        generate_preset("tiny", tmp_path, GenerateConfig(resolution=16, views=1),
+                        buildings=["nope"], progress=False)
+    assert not any(tmp_path.iterdir())
