@@ -25,8 +25,9 @@ drone circling it). With 24 views, two runs of the same renders posed 23 and 14 
 COLMAP's multi-threaded mapping is not repeatable, and 24 views of 512 px are too few to
 leave a margin."""
 # Measured (2026-11-29, pycolmap 4.2.1, twice): 32 of 32 posed, scale 0.03 / 0.04 % off,
-# median rotation 0.17 degrees, median position 0.055 m (orbit of about 30 m); about 75 s
-# on 2 cores shared with two other jobs. Tolerances leave room for another machine.
+# median rotation 0.17 degrees, median position 0.055 m (orbit of about 30 m); the test
+# takes about 40 s on 2 cores shared with a background job. Tolerances leave room for
+# another machine.
 ROTATION_TOLERANCE_DEG = 1.0
 POSITION_TOLERANCE_M = 0.5
 
