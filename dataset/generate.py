@@ -18,12 +18,13 @@ import shutil
 import signal
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, get_args
 
 import numpy as np
 from tqdm import tqdm
 
 from dataset.importers.source import BuildingEntry, Entry, NoOptions, SceneEntry, write_scenes
+from dataset.rendering.shading import LookName, RgbConfig
 from dataset.rendering.street_views import STREET_FRAMES_PER_BUILDING, StreetConfig
 from dataset.scenes.scene_writer import (
     GenerateConfig,
@@ -69,17 +70,25 @@ def scene_seed(base_seed: int, recipe_seed: int) -> int:
 def generate_preset(
     name: str, out_root: str | Path, config: GenerateConfig, *, workers: int = 1, seed: int = 0,
     overwrite: bool = False, progress: bool = True, ray: RayConfig | None = None,
-    log: Callable[[str], None] = tqdm.write,
+    log: Callable[[str], None] = tqdm.write, buildings: Sequence[str] | None = None,
 ) -> list[Path]:
-    """Generate every building of preset ``name`` into ``out_root``; return the scene folders
-    (:func:`generate_entries` of :data:`dataset.sources.PRESET_SOURCE`'s entries).
+    """Generate every building of preset ``name`` (or only those named in ``buildings``, each
+    with the seed and cameras it has in the whole preset) into ``out_root``; return the scene
+    folders (:func:`generate_entries` of :data:`dataset.sources.PRESET_SOURCE`'s entries).
 
     Raises
     ------
     ValueError
-        Unknown preset, and as :func:`generate_entries`.
+        Unknown preset or building, and as :func:`generate_entries`.
     """
-    return generate_entries(PRESET_SOURCE.read(name, NoOptions()), out_root, config,
+    entries = PRESET_SOURCE.read(name, NoOptions())
+    if buildings is not None:
+        unknown = sorted(set(buildings) - {e.name for e in entries})
+        if unknown:
+            raise ValueError(f"preset {name} has no building {', '.join(unknown)} (it has "
+                             f"{', '.join(e.name for e in entries)})")
+        entries = tuple(e for e in entries if e.name in buildings)
+    return generate_entries(entries, out_root, config,
                             workers=workers, seed=seed, overwrite=overwrite, progress=progress,
                             ray=ray, log=log, desc=f"preset {name}")
 
@@ -238,6 +247,13 @@ def _parse_args(argv: list[str] | None) -> argparse.Namespace:
                              "network (the lod3 preset's OpenDRIVE lanes; elsewhere a path "
                              "round the block), split 'street', placed without the truth "
                              "(docs/rendering.md, 'Street views')")
+    render.add_argument("--look", choices=get_args(LookName), default=RgbConfig().look,
+                        help="RGB look: 'plain' (the default, the benchmark's tables) or "
+                             "'photo', the texture photographs have (brick, render, stone, "
+                             "weathering, tiles, blinds behind glass, paving and road markings "
+                             "on the ground) for structure from motion on the images alone; "
+                             "labels and depth are the same with either (docs/rendering.md, "
+                             "'Photo look')")
     render.add_argument("--seed", type=int, default=0,
                         help="seed for cameras and looks (default 0)")
     p.add_argument("--workers", type=int, default=1,
@@ -260,7 +276,7 @@ def main(argv: list[str] | None = None) -> int:
         config = GenerateConfig(
             resolution=args.resolution, views=args.views, train_fraction=args.train_fraction,
             fov_deg=args.fov, supersampling=args.supersampling, context=args.context,
-            street=StreetConfig() if args.street else None,
+            street=StreetConfig() if args.street else None, rgb=RgbConfig(look=args.look),
         )
         source, path = chosen_source(args, SOURCES)
         if args.executor == "ray" and source is not PRESET_SOURCE:

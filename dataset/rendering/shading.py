@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from dataset.rendering import photo_look
+from dataset.rendering.noise import detail, hash01, value_noise
 from dataset.rendering.textures import TextureSet, texture_albedo
 from envelope.classes import NO_FACADE, SemanticClass
 
@@ -25,6 +27,7 @@ if TYPE_CHECKING:
     from envelope.geometry.raycast import Raycaster
 
 WallMaterial = Literal["random", "plaster", "brick"]
+LookName = Literal["plain", "photo"]
 
 # Shadow rays start this far off the surface (plus a share of the building size)
 # so that float32 Embree does not hit the surface the ray leaves.
@@ -41,6 +44,9 @@ class RgbConfig:
     ``sun_elevation_deg``: range the sun's elevation is drawn from.
     ``exposure``: tone-mapping gain. ``glass_reflectance``: Fresnel reflectance of
     glazing at normal incidence (real glass is ~0.04; windows read as glass at ~0.1).
+    ``look``: ``"plain"`` (the default) or ``"photo"``, the texture photographs have, for
+    structure from motion (:mod:`dataset.rendering.photo_look`); labels and depth are the
+    same with either.
     """
 
     shadows: bool = True
@@ -48,8 +54,11 @@ class RgbConfig:
     sun_elevation_deg: tuple[float, float] = (20.0, 65.0)
     exposure: float = 1.6
     glass_reflectance: float = 0.1
+    look: LookName = "plain"
 
     def __post_init__(self) -> None:
+        if self.look not in ("plain", "photo"):
+            raise ValueError(f"look must be 'plain' or 'photo', got {self.look!r}")
         if self.wall_material not in ("random", "plaster", "brick"):
             raise ValueError(
                 f"wall_material must be 'random', 'plaster' or 'brick', got {self.wall_material!r}"
@@ -193,6 +202,11 @@ def shade(
     out = np.empty((len(dirs), 3))
     miss = face < 0
     out[miss] = environment_radiance(d_unit[miss], look)
+    photo = photo_look.photo_materials(look) if config.look == "photo" else None
+    if photo is not None:
+        ground = miss & (d_unit[:, 2] < 0) & (origins_m[:, 2] > 0)
+        out[ground] = photo_look.ground_radiance(raycaster, origins_m[ground], d_unit[ground],
+                                                 look, photo, pixel_angle_rad)
     hit = np.flatnonzero(~miss)
     if len(hit) == 0:
         return out
@@ -226,11 +240,16 @@ def shade(
     cos_i = np.clip(-np.einsum("ij,ij->i", d, n_front), 0.15, 1.0)
     footprint_m = t[hit] * np.linalg.norm(dirs[hit], axis=1) * pixel_angle_rad / cos_i
     s, v = surface_coords(p, n_front)
+    if photo is not None:  # no two walls alike: matching must not confuse them
+        s = s + photo_look.plane_offset_m(p, n_front)
     albedo = _albedo(label, facade, s, v, look, footprint_m)
     textured = np.zeros(len(hit), dtype=bool)
     if textures is not None:
         textured, source_albedo = texture_albedo(textures, f, p, footprint_m)
         albedo[textured] = source_albedo[textured]
+    if photo is not None:
+        albedo = photo_look.surface_albedo(label, facade, s, v, n_front[:, 2], textured, albedo,
+                                           look, photo, footprint_m)
     radiance = albedo * irradiance
 
     glass = (label == SemanticClass.WINDOW) & (facade != NO_FACADE) & ~textured
@@ -238,6 +257,8 @@ def shade(
         radiance[glass] = _glass(
             d[glass], n_front[glass], s[glass], v[glass], lit[glass], irradiance[glass], look,
             config.glass_reflectance,
+            photo=None if photo is None else _PhotoGlass(raycaster, p[glass], photo,
+                                                         pixel_angle_rad, footprint_m[glass]),
         )
     out[hit] = radiance
     return out
@@ -255,38 +276,13 @@ def surface_coords(points_m: np.ndarray, normals: np.ndarray) -> tuple[np.ndarra
     return s, v
 
 
-def value_noise(x: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray:
-    """Smooth 2-D value noise in [0, 1] with unit lattice spacing, same shape as ``x``."""
-    x0, y0 = np.floor(x), np.floor(y)
-    fx, fy = x - x0, y - y0
-    fx, fy = fx * fx * (3 - 2 * fx), fy * fy * (3 - 2 * fy)
-    ix, iy = x0.astype(np.int64), y0.astype(np.int64)
-    c00, c10 = _hash01(ix, iy, seed), _hash01(ix + 1, iy, seed)
-    c01, c11 = _hash01(ix, iy + 1, seed), _hash01(ix + 1, iy + 1, seed)
-    return (c00 * (1 - fx) + c10 * fx) * (1 - fy) + (c01 * (1 - fx) + c11 * fx) * fy
-
-
-def _hash01(ix: np.ndarray, iy: np.ndarray, seed: int) -> np.ndarray:
-    # Integer hash on int64 arrays (wrap-around is intended); uniform in [0, 1].
-    h = ix * np.int64(374761393) + iy * np.int64(668265263) + np.int64(seed % 2**31) * 97
-    h = (h ^ (h >> 13)) * np.int64(1274126177)
-    h = h ^ (h >> 16)
-    return (h & 0xFFFFFF).astype(np.float64) / float(0xFFFFFF)
-
-
-def _detail(footprint_m: np.ndarray, feature_m: float) -> np.ndarray:
-    """Weight of a texture feature of size ``feature_m``: 1 while pixels resolve it, fading
-    to 0 once a pixel's footprint reaches the feature size (a cheap mip-map)."""
-    return np.clip(2.0 - 2.0 * footprint_m / feature_m, 0.0, 1.0)
-
-
 def _albedo(
     label: np.ndarray, facade: np.ndarray, s: np.ndarray, v: np.ndarray, look: Look,
     footprint_m: np.ndarray,
 ) -> np.ndarray:
     seed = look.texture_seed
     grain = 1.0 + 0.12 * (value_noise(s / 1.5, v / 1.5, seed) - 0.5)
-    grain += 0.08 * _detail(footprint_m, 0.25) * (value_noise(s / 0.25, v / 0.25, seed + 1) - 0.5)
+    grain += 0.08 * detail(footprint_m, 0.25) * (value_noise(s / 0.25, v / 0.25, seed + 1) - 0.5)
     albedo = np.broadcast_to(look.other_rgb, (len(s), 3)) * grain[:, None]
 
     wall = label == SemanticClass.WALL
@@ -297,11 +293,11 @@ def _albedo(
         albedo[wall] = look.wall_rgb * (grain[wall] * streaks)[:, None]
 
     roof = label == SemanticClass.ROOF
-    rows = 0.92 + 0.08 * _detail(footprint_m[roof], 0.35) * np.cos(2 * np.pi * v[roof] / 0.35)
+    rows = 0.92 + 0.08 * detail(footprint_m[roof], 0.35) * np.cos(2 * np.pi * v[roof] / 0.35)
     albedo[roof] = look.roof_rgb * (rows * grain[roof])[:, None]
 
     door = label == SemanticClass.DOOR
-    wood = 1.0 + 0.3 * _detail(footprint_m[door], 0.04) * (
+    wood = 1.0 + 0.3 * detail(footprint_m[door], 0.04) * (
         value_noise(s[door] * 25.0, v[door] * 0.6, seed + 3) - 0.5
     )
     albedo[door] = look.door_rgb * wood[:, None]
@@ -318,17 +314,29 @@ def _brick(s: np.ndarray, v: np.ndarray, look: Look, footprint_m: np.ndarray) ->
     u = s / brick_w + 0.5 * (row % 2)
     col = np.floor(u)
     mortar = ((u - col) < joint_u) | ((v / brick_h - row) < joint_v)
-    tone = 0.8 + 0.4 * _hash01(col.astype(np.int64), row.astype(np.int64), look.texture_seed + 4)
+    tone = 0.8 + 0.4 * hash01(col.astype(np.int64), row.astype(np.int64), look.texture_seed + 4)
     sharp = np.where(mortar[:, None], look.mortar_rgb, look.wall_rgb * tone[:, None])
     mortar_share = 1 - (1 - joint_u) * (1 - joint_v)
     mean = mortar_share * look.mortar_rgb + (1 - mortar_share) * look.wall_rgb
-    w = _detail(footprint_m, brick_h)[:, None]
+    w = detail(footprint_m, brick_h)[:, None]
     return w * sharp + (1 - w) * mean
+
+
+@dataclass(frozen=True)
+class _PhotoGlass:
+    """What glazing needs for the photo look: the scene (the ground in reflections), the hit
+    points (N, 3), the look's materials and the pixels' footprints (N,)."""
+
+    raycaster: Raycaster
+    points_m: np.ndarray
+    materials: photo_look.PhotoMaterials
+    pixel_angle_rad: float
+    footprint_m: np.ndarray
 
 
 def _glass(
     d: np.ndarray, n: np.ndarray, s: np.ndarray, v: np.ndarray, lit: np.ndarray,
-    irradiance: np.ndarray, look: Look, f0: float,
+    irradiance: np.ndarray, look: Look, f0: float, photo: _PhotoGlass | None = None,
 ) -> np.ndarray:
     cos_i = np.clip(-np.einsum("ij,ij->i", d, n), 0.0, 1.0)
     fresnel = (f0 + (1 - f0) * (1 - cos_i) ** 5)[:, None]
@@ -337,4 +345,12 @@ def _glass(
     glint = (40.0 * lit * (reflected @ look.sun_dir > np.cos(np.deg2rad(0.6))))[:, None]
     rooms = 0.6 + 0.8 * value_noise(s / 1.3, np.floor(v / 3.0) * 7.1, look.texture_seed + 5)
     interior = look.interior_rgb * rooms[:, None] * (0.5 + 0.5 * irradiance)
+    if photo is not None:
+        down = (reflected[:, 2] < 0) & (photo.points_m[:, 2] > 0)
+        mirror[down] = photo_look.ground_radiance(
+            photo.raycaster, photo.points_m[down], reflected[down], look, photo.materials,
+            photo.pixel_angle_rad)
+        interior = photo_look.window_interior(s, v, interior, irradiance, look, photo.materials,
+                                              photo.footprint_m)
     return fresnel * (mirror + glint * look.sun_rgb) + (1 - fresnel) * interior
+

@@ -339,4 +339,6 @@ def _config_json(config: GenerateConfig) -> dict[str, Any]:
     record = json.loads(json.dumps(asdict(config)))
     if config.street is None:  # scenes without street frames record what they always did
         del record["street"]
+    if config.rgb.look == "plain":  # as do scenes in the plain look
+        del record["rgb"]["look"]
     return record

@@ -103,6 +103,20 @@ def test_cli_generates_a_users_mesh_and_resumes(tmp_path, box_ply, capsys):
     assert (scene / "transforms.json").stat().st_mtime_ns == stamp
 
 
+def test_cli_look_photo_changes_the_rgb_and_is_recorded(tmp_path, box_ply):
+    common = ["--mesh", str(box_ply), "--resolution", "16", "--views", "1", "--quiet"]
+    assert main([*common, "--out", str(tmp_path / "plain")]) == 0
+    assert main([*common, "--out", str(tmp_path / "photo"), "--look", "photo"]) == 0
+    plain, photo = tmp_path / "plain" / "example_bim", tmp_path / "photo" / "example_bim"
+    record = json.loads((photo / "transforms.json").read_text())["generator"]["config"]
+    assert record["rgb"]["look"] == "photo"
+    assert (plain / "images" / "eval_0000.png").read_bytes() != (
+        photo / "images" / "eval_0000.png").read_bytes()
+    for truth in ("depth", "semantics"):
+        assert (plain / truth / "eval_0000.png").read_bytes() == (
+            photo / truth / "eval_0000.png").read_bytes()
+
+
 def _one_line_error(capsys) -> str:
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "Traceback" not in err
@@ -172,3 +186,10 @@ def test_scene_made_by_other_code_is_rerendered_with_the_reason(tmp_path, monkey
     assert logged == ["box_a: code of dataset changed; re-rendering"]
     assert scene_changes(tmp_path / "box_a", SMALL, scene_seed(0, 1),
                          {"preset": "boxes", "recipe": "box_a"}) == []
+
+
+def test_preset_run_of_named_buildings_refuses_an_unknown_name(tmp_path):
+    with pytest.raises(ValueError, match="preset tiny has no building nope .*tiny_l_shaped"):
+        generate_preset("tiny", tmp_path, GenerateConfig(resolution=16, views=1),
+                        buildings=["nope"], progress=False)
+    assert not any(tmp_path.iterdir())

@@ -2,8 +2,9 @@
 with random multi-scale texture, ray cast here with numpy) from known cameras, posed by
 structure from motion, compared with the true cameras after a similarity alignment.
 
-Today's renders are too plain for structure from motion (issue 47); this scene has the
-texture photos have, so the test checks the photos path itself. 20 photos of at most
+The renders' plain look is too plain for structure from motion (issue 47); this scene has
+the texture photos have, so the test checks the photos path itself (the photo look's own
+end-to-end test is tests/dataset/importers/test_photos_from_renders.py). 20 photos of at most
 480 x 360 px, 4 of them from another camera (other size and focal length)."""
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import numpy as np
 import pytest
 
 from dataset.generate import main as generate_main
+from dataset.importers.photos.pose_error import pose_errors
 from envelope.camera import Intrinsics, look_at, rays_world
 from envelope.scenes.scene import read_method_input
 
@@ -92,23 +94,6 @@ def write_block_photos(folder, n: int = 20) -> dict[str, tuple[np.ndarray, Intri
     return truth
 
 
-def similarity_alignment(source: np.ndarray, target: np.ndarray) -> tuple[float, np.ndarray,
-                                                                           np.ndarray]:
-    """Umeyama's least-squares similarity (scale, (3, 3) rotation, (3,) translation) taking
-    (N, 3) ``source`` points onto ``target``."""
-    mu_s, mu_t = source.mean(axis=0), target.mean(axis=0)
-    s, t = source - mu_s, target - mu_t
-    u, d, vt = np.linalg.svd(t.T @ s / len(source))
-    sign = np.diag([1.0, 1.0, np.sign(np.linalg.det(u @ vt))])
-    rotation = u @ sign @ vt
-    scale = float(np.trace(np.diag(d) @ sign) / (s ** 2).sum(axis=1).mean())
-    return scale, rotation, mu_t - scale * rotation @ mu_s
-
-
-def _angle_deg(rotation: np.ndarray) -> float:
-    return float(np.degrees(np.arccos(np.clip((np.trace(rotation) - 1) / 2, -1, 1))))
-
-
 @pytest.mark.slow
 def test_photos_of_a_textured_block_are_posed_in_metres_with_z_up(tmp_path, capsys):
     truth = write_block_photos(tmp_path / "block")
@@ -121,19 +106,14 @@ def test_photos_of_a_textured_block_are_posed_in_metres_with_z_up(tmp_path, caps
     assert record["unposed"] == [] and "x axes" in record["up"]
     names = [f.file_path.removeprefix("images/") for f in scene.frames]
     assert names == sorted(truth)
-    posed = np.stack([f.world_from_camera for f in scene.frames])
-    true = np.stack([truth[n][0] for n in names])
-    scale, rotation, shift = similarity_alignment(posed[:, :3, 3], true[:, :3, 3])
+    errors = pose_errors(np.stack([f.world_from_camera for f in scene.frames]),
+                         np.stack([truth[n][0] for n in names]))
     # Metres: the known distance fixes the scale.
-    assert abs(scale - 1) < SCALE_TOLERANCE
+    assert errors.scale_error < SCALE_TOLERANCE
     # z up: the alignment turns about z only.
-    assert np.degrees(np.arccos(rotation[2, 2])) < UP_TOLERANCE_DEG
-    rotation_errors = [_angle_deg(true[i, :3, :3].T @ rotation @ posed[i, :3, :3])
-                       for i in range(len(names))]
-    position_errors = np.linalg.norm(scale * posed[:, :3, 3] @ rotation.T + shift
-                                     - true[:, :3, 3], axis=1)
-    assert max(rotation_errors) < ROTATION_TOLERANCE_DEG
-    assert position_errors.max() < POSITION_TOLERANCE_M
+    assert errors.up_deg < UP_TOLERANCE_DEG
+    assert errors.rotation_deg.max() < ROTATION_TOLERANCE_DEG
+    assert errors.position_m.max() < POSITION_TOLERANCE_M
     # Both cameras' focal lengths, each from its own intrinsics.
     for frame, name in zip(scene.frames, names):
         assert frame.intrinsics.fx == pytest.approx(truth[name][1].fx, rel=FOCAL_TOLERANCE)
