@@ -19,11 +19,11 @@ from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
+from dataset.rendering.look import Look
 from dataset.rendering.noise import detail, hash01, value_noise
 from envelope.classes import NO_FACADE, SemanticClass
 
 if TYPE_CHECKING:
-    from dataset.rendering.shading import Look
     from envelope.geometry.raycast import Raycaster
 
 PhotoWall = Literal["brick", "render", "stone"]

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from dataset.rendering import photo_look
+from dataset.rendering.look import Look
 from dataset.rendering.noise import detail, hash01, value_noise
 from dataset.rendering.textures import TextureSet, texture_albedo
 from envelope.classes import NO_FACADE, SemanticClass
@@ -68,26 +69,6 @@ class RgbConfig:
             raise ValueError(f"sun_elevation_deg must satisfy 0 < lo <= hi <= 90, got {lo, hi}")
         if self.exposure <= 0 or not 0 <= self.glass_reflectance <= 1:
             raise ValueError("exposure must be > 0 and glass_reflectance in [0, 1]")
-
-
-@dataclass(frozen=True)
-class Look:
-    """One building's appearance; colours are linear RGB (3,) arrays, ``sun_dir`` a unit vector."""
-
-    sun_dir: np.ndarray
-    sun_rgb: np.ndarray
-    sky_zenith_rgb: np.ndarray
-    sky_horizon_rgb: np.ndarray
-    ground_rgb: np.ndarray
-    wall_material: Literal["plaster", "brick"]
-    wall_rgb: np.ndarray
-    mortar_rgb: np.ndarray
-    roof_rgb: np.ndarray
-    frame_rgb: np.ndarray
-    door_rgb: np.ndarray
-    other_rgb: np.ndarray
-    interior_rgb: np.ndarray
-    texture_seed: int
 
 
 _PLASTER = ((0.80, 0.78, 0.72), (0.85, 0.75, 0.55), (0.62, 0.62, 0.60), (0.78, 0.62, 0.50),

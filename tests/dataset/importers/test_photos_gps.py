@@ -376,7 +376,9 @@ GPS_HEADING_TOLERANCE_DEG = 4.0
 @pytest.mark.slow
 def test_photos_of_a_textured_block_with_noisy_gps_come_out_in_metres_north_up(tmp_path,
                                                                              capsys):
-    from test_photos_sfm import similarity_alignment, write_block_photos
+    from test_photos_sfm import write_block_photos
+
+    from dataset.importers.photos.pose_error import similarity_alignment
 
     truth = write_block_photos(tmp_path / "png")
     noise = np.random.default_rng(5).normal(0.0, GPS_NOISE_M, (len(truth), 2))
