@@ -14,7 +14,7 @@ below it; the ground is not geometry, so the building casts no shadow on it.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 
@@ -58,8 +58,9 @@ class RgbConfig:
     look: LookName = "plain"
 
     def __post_init__(self) -> None:
-        if self.look not in ("plain", "photo"):
-            raise ValueError(f"look must be 'plain' or 'photo', got {self.look!r}")
+        if self.look not in get_args(LookName):
+            names = " or ".join(repr(n) for n in get_args(LookName))
+            raise ValueError(f"look must be {names}, got {self.look!r}")
         if self.wall_material not in ("random", "plaster", "brick"):
             raise ValueError(
                 f"wall_material must be 'random', 'plaster' or 'brick', got {self.wall_material!r}"
@@ -334,4 +335,3 @@ def _glass(
         interior = photo_look.window_interior(s, v, interior, irradiance, look, photo.materials,
                                               photo.footprint_m)
     return fresnel * (mirror + glint * look.sun_rgb) + (1 - fresnel) * interior
-

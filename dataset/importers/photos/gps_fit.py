@@ -109,9 +109,11 @@ def check_fixes(east_north: np.ndarray, photos: int) -> None:
             f"from further round the building, or {FALLBACK_OPTIONS}")
 
 
-def fit_gps(source_xy: np.ndarray, east_north: np.ndarray) -> GpsFit:
+def fit_gps(source_xy: np.ndarray, east_north: np.ndarray,
+            photos: int | None = None) -> GpsFit:
     """The similarity from (N, 2) levelled camera centres to their (N, 2) GPS metres,
-    robust to bad fixes (module docstring).
+    robust to bad fixes (module docstring); ``photos``: how many photos the N fixes are of,
+    for the messages (default N).
 
     Raises
     ------
@@ -120,7 +122,8 @@ def fit_gps(source_xy: np.ndarray, east_north: np.ndarray) -> GpsFit:
         :data:`MIN_FIXES` agreeing within :data:`OUTLIER_M`.
     """
     source, target = _complex(source_xy), _complex(east_north)
-    check_fixes(east_north, len(target))
+    photos = len(target) if photos is None else photos
+    check_fixes(east_north, photos)
     first, second = _pairs(len(target))
     ds = source[second] - source[first]
     usable = np.abs(ds) > 1e-12 * max(1.0, float(np.abs(source).max()))
@@ -148,7 +151,7 @@ def fit_gps(source_xy: np.ndarray, east_north: np.ndarray) -> GpsFit:
             f"--gps: only {int(kept.sum())} of {len(target)} GPS positions agree with the "
             f"photos' layout within {OUTLIER_M:g} m; at least {MIN_FIXES} must: "
             f"{FALLBACK_OPTIONS}")
-    check_fixes(np.asarray(east_north)[kept], len(target))
+    check_fixes(np.asarray(east_north)[kept], photos)
     return GpsFit(similarity, kept, residuals, spread_m(np.asarray(east_north)[kept]))
 
 

@@ -112,8 +112,7 @@ def gps_frame(world_from_camera: np.ndarray, names: Sequence[str], level: np.nda
     """
     poses = np.asarray(world_from_camera, dtype=np.float64)
     with_fix, origin, east_north = fixes_east_north(fixes)
-    check_fixes(east_north, len(fixes))  # the message counts every posed photo
-    fit = fit_gps((poses[list(with_fix), :3, 3] @ level.T)[:, :2], east_north)
+    fit = fit_gps((poses[list(with_fix), :3, 3] @ level.T)[:, :2], east_north, len(fixes))
     heading = fit.similarity.heading_rad
     turn_z = np.array([[np.cos(heading), -np.sin(heading), 0.0],
                        [np.sin(heading), np.cos(heading), 0.0], [0.0, 0.0, 1.0]])

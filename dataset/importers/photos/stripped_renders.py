@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+from PIL import ExifTags, Image
 
 from dataset.importers.photos.metric_frame import KnownDistance, ScaleHint
 from dataset.importers.photos.photo_folder import FULL_FRAME_WIDTH_MM
@@ -29,7 +29,6 @@ from envelope.scenes.scene import read_scene
 CAMERA_MAKE = "envelope-bench"
 CAMERA_MODEL = "render"
 JPEG_QUALITY = 95
-_EXIF_MAKE, _EXIF_MODEL, _EXIF_IFD, _EXIF_FOCAL_35MM = 0x010F, 0x0110, 0x8769, 0xA405
 
 
 @dataclass(frozen=True)
@@ -79,9 +78,9 @@ def strip_renders(scene_dir: str | Path, photos_dir: str | Path,
         name = Path(frame.file_path).stem + ".jpg"
         k = frame.intrinsics
         exif = Image.Exif()
-        exif[_EXIF_MAKE], exif[_EXIF_MODEL] = CAMERA_MAKE, CAMERA_MODEL
+        exif[ExifTags.Base.Make], exif[ExifTags.Base.Model] = CAMERA_MAKE, CAMERA_MODEL
         focal_35mm = round(k.fx / max(k.width, k.height) * FULL_FRAME_WIDTH_MM)
-        exif.get_ifd(_EXIF_IFD)[_EXIF_FOCAL_35MM] = focal_35mm
+        exif.get_ifd(ExifTags.IFD.Exif)[ExifTags.Base.FocalLengthIn35mmFilm] = focal_35mm
         with Image.open(scene.path(frame.file_path)) as image:
             image.convert("RGB").save(photos_dir / name, format="JPEG", quality=JPEG_QUALITY,
                                       exif=exif)
