@@ -33,8 +33,8 @@ from scipy.spatial import Delaunay, QhullError
 
 from envelope.camera import Intrinsics, project_world_to_image
 
-EDGE_TOLERANCE = 1e-9
-"""A pixel centre is inside a triangle when no barycentric coordinate is below minus this."""
+SUBPIXEL_BITS = 8
+"""Corners are drawn to 1/256 px (OpenCV's ``shift``)."""
 
 
 @dataclass(frozen=True)
@@ -85,28 +85,31 @@ def piecewise_planar_depth_z_m(points_world_m: np.ndarray, intrinsics: Intrinsic
     camera_xyz = _camera_points(uv, z_m, intrinsics)
     kept = np.flatnonzero(_facing(camera_xyz[triangles.simplices], config.max_incidence_deg))
     triangle_of_pixel = _rasterise(uv, triangles.simplices, kept, depth.shape)
-    rows, cols = np.nonzero(triangle_of_pixel >= 0)
-    centres = np.column_stack([cols + 0.5, rows + 0.5])
-    which = triangle_of_pixel[rows, cols]
-    # A pixel on an edge was drawn with either triangle, or with one beside the hull: it
+    # A pixel near an edge was drawn with either triangle, or with one beside the hull: it
     # goes to the triangle holding its centre (-1: none), and is dropped unless that is kept.
-    edge = np.flatnonzero((_barycentric(triangles, which, centres) < -EDGE_TOLERANCE).any(1))
-    which[edge] = triangles.find_simplex(centres[edge])
+    rows, cols = np.nonzero(_near_edges(uv, triangles.simplices[kept], depth.shape)
+                            & (triangle_of_pixel >= 0))
+    which = triangles.find_simplex(np.column_stack([cols + 0.5, rows + 0.5]))
     is_kept = np.zeros(len(triangles.simplices) + 1, bool)  # the last entry: index -1
     is_kept[kept] = True
-    inside = is_kept[which]
-    rows, cols, which, centres = rows[inside], cols[inside], which[inside], centres[inside]
-    inverse_z = np.einsum("pi,pi->p", _barycentric(triangles, which, centres),
-                          1.0 / z_m[triangles.simplices[which]])
+    triangle_of_pixel[rows, cols] = np.where(is_kept[which], which, -1)
+    gradient, offset = _inverse_depth_planes(triangles, 1.0 / z_m)
+    rows, cols = np.nonzero(triangle_of_pixel >= 0)
+    which = triangle_of_pixel[rows, cols]
+    inverse_z = gradient[which, 0] * (cols + 0.5) + gradient[which, 1] * (rows + 0.5) \
+        + offset[which]
     depth[rows, cols] = 1.0 / inverse_z
     return depth
 
 
-def _barycentric(triangles: Delaunay, which: np.ndarray, uv: np.ndarray) -> np.ndarray:
-    """(P, 3) barycentric coordinates of (P, 2) image points in the triangles ``which``."""
-    affine = triangles.transform[which]  # (P, 3, 2): the last row is the third corner
-    b2 = np.einsum("pij,pj->pi", affine[:, :2], uv - affine[:, 2])
-    return np.column_stack([b2, 1.0 - b2.sum(axis=1)])
+def _inverse_depth_planes(triangles: Delaunay, inverse_z: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray]:
+    """Each triangle's inverse depth as an affine function of the image point,
+    ``gradient . (u, v) + offset``: (T, 2) and (T,), through its corners' (N,) ``inverse_z``."""
+    affine = triangles.transform  # (T, 3, 2): barycentric from (u, v), third corner last
+    w = inverse_z[triangles.simplices]  # (T, 3)
+    gradient = np.einsum("tji,tj->ti", affine[:, :2], w[:, :2] - w[:, 2:])
+    return gradient, w[:, 2] - np.einsum("ti,ti->t", gradient, affine[:, 2])
 
 
 def _camera_points(uv: np.ndarray, z_m: np.ndarray, k: Intrinsics) -> np.ndarray:
@@ -126,6 +129,15 @@ def _facing(corners: np.ndarray, max_incidence_deg: float) -> np.ndarray:
     return cos >= np.cos(np.radians(max_incidence_deg)) - 1e-12
 
 
+def _near_edges(uv: np.ndarray, simplices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """(H, W) bool: pixels within about two pixels of an edge of the (T, 3) triangles, where
+    :func:`_rasterise` may have drawn a triangle beside the one holding the pixel's centre."""
+    corners = np.round((uv - 0.5) * (1 << SUBPIXEL_BITS)).astype(np.int32)
+    mask = np.zeros(shape, np.uint8)
+    cv2.polylines(mask, list(corners[simplices]), True, 1, 1, cv2.LINE_8, SUBPIXEL_BITS)
+    return cv2.dilate(mask, np.ones((3, 3), np.uint8)).astype(bool)
+
+
 def _rasterise(uv: np.ndarray, simplices: np.ndarray, kept: np.ndarray,
                shape: tuple[int, int]) -> np.ndarray:
     """(H, W) int32: the index of the kept triangle covering each pixel, -1 for none.
@@ -133,11 +145,10 @@ def _rasterise(uv: np.ndarray, simplices: np.ndarray, kept: np.ndarray,
     OpenCV fills a triangle's boundary pixels as well (pixel centres at integers there, so
     the corners are shifted by -0.5): a pixel on an edge shared by two triangles takes the
     one drawn last, and a pixel just outside the hull the triangle beside it (the caller
-    sorts those out).
+    sorts those out, :func:`_near_edges`).
     """
-    shift = 8  # sub-pixel bits for cv2.fillPoly
-    corners = np.round((uv - 0.5) * (1 << shift)).astype(np.int32)
+    corners = np.round((uv - 0.5) * (1 << SUBPIXEL_BITS)).astype(np.int32)
     out = np.full(shape, -1, np.int32)
     for t in kept:
-        cv2.fillPoly(out, [corners[simplices[t]]], int(t), shift=shift)
+        cv2.fillPoly(out, [corners[simplices[t]]], int(t), shift=SUBPIXEL_BITS)
     return out
