@@ -22,7 +22,7 @@ from tqdm import tqdm
 from dataset.benchmark_cache import DefaultBenchmark, default_results_folder, ensure_benchmark
 from envelope.cli_errors import add_debug_flag, check_output_folder, one_line, run_cli
 from envelope.method_input import MethodInput
-from envelope.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
+from envelope.protocols import STREET_PROTOCOL, TRAIN_PROTOCOL, VIEW_PROTOCOLS
 from envelope.results import MethodResult, write_result
 from envelope.scenes.scene import find_scene_folders, read_method_input
 from envelope.warnings_summary import summarise_warnings
@@ -65,11 +65,13 @@ def _figure(value: float | None, digits: int) -> str:
 
 def add_common_arguments(parser: argparse.ArgumentParser) -> None:
     """--views, --data, --out, --debug-images and --debug."""
-    parser.add_argument("--views", required=True, choices=(*VIEW_PROTOCOLS, STREET_PROTOCOL),
+    parser.add_argument("--views", required=True,
+                        choices=(*VIEW_PROTOCOLS, TRAIN_PROTOCOL, STREET_PROTOCOL),
                         help="view protocol: 'ideal' (one perpendicular view per facade), "
                              "'multi' (several natural views per facade), both aimed at the "
-                             "truth's facades, or 'street' (a street capture, scenes made with "
-                             "--street: the method finds its own facades)")
+                             "truth's facades, 'train' (the orbit views; a photos scene's "
+                             "photos) or 'street' (a street capture, scenes made with --street); "
+                             "on 'train' and 'street' the method finds its own facades")
     parser.add_argument("--data", type=Path, default=None,
                         help="a scene folder (with transforms.json) or a folder of scene folders "
                              "(default: the built-in tiny benchmark of metrics.compare, "

@@ -85,7 +85,10 @@ def load_posed_views(scene: MethodInput, split: str) -> PosedViews:
     """Read the semantic and depth images of every frame of ``split``.
 
     A view without a semantic mask, without readable depth or without a facade pixel with
-    depth is skipped with a warning.
+    depth is skipped with a warning. Depth may cover part of the building only (a photos
+    scene's depth comes from the sparse points of structure from motion, docs/importing.md
+    section 9): its holes are pixels without depth, not a scene error, so the share of the
+    building with depth is not checked here.
 
     Raises
     ------
@@ -107,7 +110,7 @@ def load_posed_views(scene: MethodInput, split: str) -> PosedViews:
         view_name = f"{name}: view {frame.file_path}"
         try:
             labels = read_frame_labels(scene, frame)
-            depth = read_frame_depth_m(scene, frame, labels)
+            depth = read_frame_depth_m(scene, frame)
         except InvalidSceneError:
             raise
         except ValueError as exc:  # no semantic mask or no (readable) depth

@@ -12,6 +12,7 @@ import pytest
 from baselines_synthetic import facade_pose, true_wwr, window_grid, write_facade_scene
 from conftest import make_box_building
 
+from baselines import wwr2ds, wwr2dss
 from baselines.facade_cells import measure_facades
 from baselines.own_facades import OwnFacadesConfig, find_own_facades
 from baselines.plane_merge import merge_view_planes
@@ -25,8 +26,9 @@ from dataset.rendering.render import render_ground_truth
 from dataset.scenes.scene_writer import generate_scene
 from envelope.camera import Intrinsics, look_at
 from envelope.classes import SemanticClass
+from envelope.results import read_result
 from envelope.scene_record import Frame
-from envelope.scenes.images import write_labels
+from envelope.scenes.images import read_depth_m, read_labels, write_depth_m, write_labels
 from envelope.scenes.scene import read_method_input, read_scene, write_transforms
 from envelope.truth import Building
 from metrics.score.errors import building_errors, facade_errors
@@ -173,3 +175,31 @@ def test_street_views_along_the_box_find_the_walls_they_see(box_building):
         assert np.degrees(np.arccos(min(1.0, np.dot(wall.normal, facade.normal)))) < NORMAL_DEG
         assert cells.areas.gross_m2 == pytest.approx(wall.facade_area_m2, rel=AREA_REL)
         assert 100 * abs(cells.areas.wwr - wall.wwr) < WWR_POINTS
+
+
+def test_views_whose_depth_covers_under_half_the_building_are_used(tmp_path):
+    """A photos scene's depth comes from sparse points and covers part of each photo
+    (docs/importing.md, section 9): holes are pixels without depth, not a scene error."""
+    scene = _synthetic_scene(tmp_path)
+    for frame in scene.frames[:3]:
+        depth = read_depth_m(scene.path(frame.depth_file_path), scene.depth_unit_scale_factor)
+        building = read_labels(scene.path(frame.semantic_file_path)) != SemanticClass.BACKGROUND
+        depth[:, : int(0.6 * K.width)] = 0.0
+        assert (building & (depth == 0)).sum() > 0.5 * building.sum()
+        write_depth_m(scene.path(frame.depth_file_path), depth, scene.depth_unit_scale_factor)
+    (f,) = run_2dss(read_method_input(scene.root), "train").facades
+    assert f.views_used == 3
+    np.testing.assert_allclose(f.normal, [0.0, -1.0, 0.0], atol=np.radians(NORMAL_DEG))
+
+
+def test_the_command_lines_run_on_train_views(tmp_path, capsys):
+    """``--views train``: a photos scene's photos are ``train`` frames (docs/importing.md,
+    section 9); the result file is the one ``metrics.compare`` would name."""
+    scene = _synthetic_scene(tmp_path)
+    out = tmp_path / "results"
+    for cli, method in ((wwr2dss, "2D-SS"), (wwr2ds, "2D-S")):
+        assert cli.main(["--views", "train", "--data", str(scene.root), "--out", str(out)]) == 0
+        result = read_result(out / f"{scene.root.name}__{method}__train.json")
+        assert (result.protocol, result.facade_identity, len(result.facades)) == (
+            "train", "geometry", 1)
+    assert "2D-SS train: building WWR" in capsys.readouterr().out

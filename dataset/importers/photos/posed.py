@@ -27,13 +27,15 @@ class PosedPhoto:
     ``path``: its pixels, read upright (EXIF orientation applied) when ``upright``, else as
     stored (what COLMAP and nerfstudio read); ``camera``: a COLMAP camera (any model, with
     its distortion); ``world_from_camera``: (4, 4) OpenGL camera-to-world pose in the input's
-    frame."""
+    frame; ``observed_points``: (N, 3) the sparse points the photo observes (its 2D-3D
+    correspondences), input frame, ``None`` where the input has no points (nerfstudio)."""
 
     name: str
     path: Path
     upright: bool
     camera: pycolmap.Camera
     world_from_camera: np.ndarray
+    observed_points: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -65,8 +67,16 @@ def from_reconstruction(model: pycolmap.Reconstruction, image_dir: Path,
             raise ValueError(f"{path}: the model's image {image.name!r} is not there")
         photos.append(PosedPhoto(Path(image.name).name, path, upright,
                                  model.cameras[image.camera_id],
-                                 world_from_camera_gl(image.cam_from_world().matrix())))
+                                 world_from_camera_gl(image.cam_from_world().matrix()),
+                                 observed_points(model, image)))
     return tuple(photos)
+
+
+def observed_points(model: pycolmap.Reconstruction, image: pycolmap.Image) -> np.ndarray:
+    """(N, 3) float64 the model's 3D points ``image`` observes (one per 2D-3D
+    correspondence)."""
+    xyz = [model.points3D[p.point3D_id].xyz for p in image.get_observation_points2D()]
+    return np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
 
 
 def sparse_points(model: pycolmap.Reconstruction) -> np.ndarray:

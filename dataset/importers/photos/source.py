@@ -4,7 +4,9 @@ nerfstudio ``transforms.json`` (docs/importing.md, section 9).
 
 The scene holds ``transforms.json`` (every posed photo a ``train`` frame, OpenGL
 camera-to-world poses in metres with z up, pinhole intrinsics) and ``images/`` (the photos
-undistorted, upright); no depth, no masks and no ``building.json``: photos carry no truth.
+undistorted, upright), ``depth/`` (each photo's depth from the sparse points it observes,
+:mod:`dataset.importers.photos.photo_depth`; none from a nerfstudio file), no masks and no
+``building.json``: photos carry no truth.
 Its ``photos`` record says how the poses, up, scale and origin were found and which photos
 got no pose. The scale is checked before anything runs (none given: refused); the scene is
 written into a temporary folder renamed when complete, so a failure leaves nothing.
@@ -31,6 +33,7 @@ from dataset.importers.photos.existing import (
 from dataset.importers.photos.gps import read_gps_fix
 from dataset.importers.photos.gps_frame import check_photo_fixes
 from dataset.importers.photos.metric_frame import NO_SCALE, ScaleHint, metric_similarity
+from dataset.importers.photos.photo_depth import with_photo_depths
 from dataset.importers.photos.photo_folder import PHOTO_SUFFIXES, Photo, list_photos
 from dataset.importers.photos.posed import (
     PosedPhotos,
@@ -154,6 +157,7 @@ def _write(read: Callable[[Path], PosedPhotos], path: Path, options: PhotosOptio
     record = {**posed.record, **frame_record, "posed": len(frames),
               "unposed": list(posed.unposed), "scale_factor": similarity.scale}
     scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
+    scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY)
     write_transforms(out_dir, scene)
     return scene
 

@@ -119,3 +119,6 @@ def test_a_nerfstudio_file_keeps_its_origin_and_is_undistorted(tmp_path, capsys,
     assert np.abs(out[:, :3, 3] - (truth[:, :3, 3] - origin) @ turn_z.T).max() < 1e-9
     scene = read_method_input(tmp_path / "out" / "capture")
     assert (scene.frames[0].intrinsics == K) == (k1 == 0.0)
+    # A nerfstudio file has no points: no depth.
+    assert all(f.depth_file_path is None for f in scene.frames)
+    assert not (tmp_path / "out" / "capture" / "depth").exists()
