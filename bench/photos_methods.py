@@ -133,6 +133,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--methods", default="2D-S,2D-SS,neural3d")
     p.add_argument("--neural3d-steps", type=int, default=2000)
     p.add_argument("--neural3d-resolution", type=int, default=128)
+    p.add_argument("--neural3d-threads", type=int, default=1,
+                   help="torch threads per training (default 1: the cores are shared)")
     p.add_argument("--work", type=Path, required=True,
                    help="renders, posed photos, scenes and results stay here")
     args = p.parse_args(argv)
@@ -144,7 +146,8 @@ def main(argv: list[str] | None = None) -> int:
                "--methods", args.methods, "--views", protocol,
                "--results", str(args.work / "results"), "--out", str(compare),
                "--neural3d-steps", str(args.neural3d_steps),
-               "--neural3d-resolution", str(args.neural3d_resolution)]
+               "--neural3d-resolution", str(args.neural3d_resolution),
+               "--neural3d-threads", str(args.neural3d_threads)]
     print("$ " + " ".join(command), file=sys.stderr)
     subprocess.run(command, check=True, cwd=Path(__file__).resolve().parents[1])
     print(markdown_table("The methods on true and on recovered cameras (same images, exact "
