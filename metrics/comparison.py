@@ -178,7 +178,7 @@ def compare(
                produced_by=f"{command}; {'; '.join(truth_notes)}")
     for spec in specs:
         write_mesh_pointers(scene_dirs, spec, out_dir)
-    with_images = [s for s in specs if s.debug_images is not None]
+    with_images = [s for s in specs if s.debug_images is not None and s.protocols]
     if allow_run and with_images:
         keep_pipeline_images(scene_dirs, with_images[0], out_dir / PIPELINE_FOLDER)
     write_json_atomic(out_dir / PROVENANCE_FILE, provenance)
