@@ -2,7 +2,7 @@
 
 Every frame's semantic image is replaced by ``segmenter(rgb)`` (a frame without one
 gets ``semantics/<image name>.png``); every other file, the truth included, is a hard
-link to the original (:func:`dataset.degrade.scene_copy.link_tree`), so the source is
+link to the original (:func:`dataset.scenes.links.link_tree`), so the source is
 never modified. Given ``splits``, only the frames of those splits are segmented and
 kept: the others leave the copy's ``transforms.json`` and their exact semantic and
 instance images leave the copy (no exact mask is left for a method to find).
@@ -25,7 +25,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from dataset.degrade.scene_copy import link_tree
+from dataset.scenes.links import link_tree
 from envelope.atomic import atomic_directory
 from envelope.classes import CLASS_NAMES
 from envelope.photo_io import read_photo_rgb

@@ -2,7 +2,7 @@
 
 Files that a degradation does not change (and the truth: ``building.json``,
 ``mesh.ply``, ``instances/``) are hard links to the original (copies across
-file systems, :func:`link_tree`, which the segmenter's mask copies share too);
+file systems, :func:`dataset.scenes.links.link_tree`, which the segmenter's mask copies share too);
 changed images are written as new files, so the original scene is never
 modified. ``transforms.json`` records the specs and the source under
 ``degradation``, which is how a rerun recognises a finished copy.
@@ -11,8 +11,6 @@ modified. ``transforms.json`` records the specs and the source under
 from __future__ import annotations
 
 import json
-import os
-import shutil
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -31,6 +29,7 @@ from dataset.degrade.masks import (
 from dataset.degrade.occluders import place_occluders, render_occluders
 from dataset.degrade.poses import pose_noise
 from dataset.degrade.spec import DegradeSpec
+from dataset.scenes.links import link_tree
 from envelope.atomic import atomic_directory
 from envelope.mesh import read_labelled_ply
 from envelope.scene_record import Frame, Scene
@@ -151,17 +150,3 @@ def _finished(out: Path, record: dict[str, Any]) -> bool:
         return json.loads(tf.read_text()).get(RECORD_KEY) == json.loads(json.dumps(record))
     except json.JSONDecodeError:
         return False
-
-
-def link_tree(src: Path, dst: Path) -> None:
-    """Hard-link every file of ``src`` into ``dst`` (copy where linking is impossible)."""
-    for path in sorted(src.rglob("*")):
-        target = dst / path.relative_to(src)
-        if path.is_dir():
-            target.mkdir(parents=True, exist_ok=True)
-            continue
-        target.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            os.link(path, target)
-        except OSError:
-            shutil.copy2(path, target)

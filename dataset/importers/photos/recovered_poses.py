@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from dataset.degrade.scene_copy import link_tree
+from dataset.scenes.links import link_tree
 from envelope.atomic import atomic_directory
 from envelope.camera import Intrinsics
 from envelope.scene_record import Frame, Scene
