@@ -13,9 +13,12 @@ from baselines.wwr2ds import Wwr2dsConfig, run_2ds
 from baselines.wwr2dss import Wwr2dssConfig, run_2dss
 from envelope.method import Method
 from envelope.method_input import MethodInput
-from envelope.protocols import STREET_PROTOCOL, VIEW_PROTOCOLS
+from envelope.protocols import STREET_PROTOCOL, TRAIN_PROTOCOL, VIEW_PROTOCOLS
 
-PROTOCOLS_2D = (*VIEW_PROTOCOLS, STREET_PROTOCOL)  # the street capture: their own facades
+PROTOCOLS_2D = (*VIEW_PROTOCOLS, TRAIN_PROTOCOL, STREET_PROTOCOL)
+"""In the tables' order (``envelope.protocols.PROTOCOLS``): the paper's facade views (``ideal``,
+``multi``), then the views without facade ids, on which they find their own facades
+(:mod:`baselines.own_facades`): the orbit (``train``, as neural3d) and a street capture."""
 LIBRARIES = ("numpy", "torch", "kornia", "opencv-contrib-python-headless")
 
 

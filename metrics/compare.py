@@ -1,10 +1,10 @@
 """``python -m metrics.compare``: run what is missing, then print and write Tables 2 and 3.
 
 With no arguments it runs the built-in default (the ``tiny`` benchmark, made
-into a cache folder on first use, every method, both view protocols, each
-method's short-run settings, ``Method.short_run``). With ``--data`` it compares
-on a benchmark or a user's scenes. Outputs (``--out``): the tables as CSV,
-Markdown and LaTeX, per-building and per-facade CSVs, plots (PNG + PDF),
+into a cache folder on first use, every method on the default views ``ideal``, ``multi``
+and ``train`` that it declares, each method's short-run settings, ``Method.short_run``).
+With ``--data`` it compares on a benchmark or a user's scenes. Outputs (``--out``): the
+tables as CSV, Markdown and LaTeX, per-building and per-facade CSVs, plots (PNG + PDF),
 ``provenance.json``, the estimated footprints, the pipeline images of one facade
 (of the first method that writes them) and, for each method that keeps a mesh,
 ``<method>_runs.json`` pointing at its meshes: everything ``figures.make`` reads;

@@ -4,7 +4,8 @@ For each building: the truth's facades (method :data:`TRUTH_METHOD`) and each
 result's facades, with outward azimuth and EnergyPlus bin
 (:mod:`envelope.orientation`), gross / wall / window / door areas (m²) and WWR.
 A facade's azimuth comes from, in this order: the truth's normal (truth rows);
-the estimate's own ``normal`` (methods that locate their facades: neural3d);
+the estimate's own ``normal`` (methods that locate their facades: neural3d, and the 2D
+methods on views without facade ids, ``train`` and ``street``);
 the truth facade with the same id (results on ideal / multi views, whose ids
 are the scene's). Methods measure gross and window areas but do not separate
 doors from wall: their ``wall_m2`` and ``door_m2`` stay empty.

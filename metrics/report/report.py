@@ -85,7 +85,8 @@ def per_building_table(rows: Sequence[BuildingErrors]) -> Table:
 
 
 def per_facade_table(rows: Sequence[FacadeErrors]) -> Table:
-    """Every facade of the ideal/multi runs: status, reason, WWR and errors (APE in %)."""
+    """Every facade of every run, paired by the one scoring rule (matched, missed, false
+    positive): status, reason, WWR and errors (APE in %)."""
     names = tuple(f.name for f in fields(FacadeErrors))
     return Table(
         name=PER_FACADE_NAME,

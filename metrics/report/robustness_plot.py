@@ -14,6 +14,9 @@ from matplotlib.figure import Figure
 from metrics.report.plots import save_figure
 from metrics.score.aggregate import method_rank, protocol_rank
 
+MARKERS = "osD^v<>"
+"""One marker per curve (method and views), repeated past the seventh (both 2D methods on
+four protocols and neural3d on two make ten)."""
 SEVERITY_UNITS = {
     "mask_noise": "level", "occluders": "occluders per facade", "pose": "degrees",
     "depth_noise": "level", "mask_erode": "px", "mask_dilate": "px", "mask_bleed": "px",
@@ -48,7 +51,8 @@ def plot_robustness(rows: Sequence[RobustnessRow], stem: str | Path,
     fig = Figure(figsize=(3.4 * len(degradations), 3.4), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, len(degradations)))
     for ax, name in zip(axes, degradations):
-        for (method, protocol), marker in zip(series, "osD^v<>"):
+        for k, (method, protocol) in enumerate(series):
+            marker = MARKERS[k % len(MARKERS)]  # cycled: no series is left out
             pts = sorted((r.severity, getattr(r, attr)) for r in rows
                          if r.degradation == name and r.method == method
                          and r.protocol == protocol)

@@ -66,10 +66,12 @@ def parse_compare_args(argv: Sequence[str] | None,
     parser.add_argument("--views", default=",".join(DEFAULT_PROTOCOLS),
                         help="comma-separated view protocols; each method runs on those it "
                         "declares (--list-methods): ideal, multi (views aimed at the truth's "
-                        "facades, as in the paper), train (the orbit views), street (a street "
-                        "capture placed without the truth, scenes made with --street); on train "
-                        "and street every method finds its own facades (default: "
-                        f"{','.join(DEFAULT_PROTOCOLS)})")
+                        "facades, as in the paper: the 2D methods), train (the orbit views, "
+                        "a photos scene's photos: every built-in method), street (a street "
+                        "capture placed without the truth, scenes made with --street: every "
+                        "built-in method); on train and street every method finds its own "
+                        f"facades (default: {','.join(DEFAULT_PROTOCOLS)}; a photos scene: "
+                        "train)")
     parser.add_argument("--results", type=Path,
                         help="folder of result JSONs to read and fill (default: <data>-results)")
     parser.add_argument("--out", type=Path,

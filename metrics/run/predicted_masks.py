@@ -86,11 +86,13 @@ class PredictedRun:
 
 def splits_read(specs: Sequence[MethodSpec]) -> tuple[str, ...]:
     """The frame splits the methods read: their protocols (``ideal``, ``multi``: the
-    facade views of the 2D methods; ``train``: the orbit views), and with ``train`` the
-    held-out ``eval`` orbit views a trained method renders for its own checks. Only these
-    are segmented: the 2D methods read 828 of the ``paper`` preset's 6428 frames."""
+    facade views of the 2D methods; ``train``: the orbit views, every built-in method's),
+    and the held-out ``eval`` orbit views when a trained method (one that keeps a run folder,
+    ``artefacts_dir``: neural3d) runs on ``train``: it renders them for its own checks. Only
+    these are segmented: the 2D methods read 828 of the ``paper`` preset's 6428 frames on
+    ``ideal`` and ``multi``, and the orbit's ``train`` frames besides."""
     splits = {p for s in specs for p in s.protocols}
-    if TRAIN_PROTOCOL in splits:
+    if any(TRAIN_PROTOCOL in s.protocols and s.artefacts_dir is not None for s in specs):
         splits.add(EVAL_SPLIT)
     return tuple(sorted(splits))
 

@@ -29,6 +29,13 @@ def compared(tmp_path_factory):
     return out, buf.getvalue()
 
 
+# The hand-made results have no 2D train result, and --no-run computes none: the 2D methods'
+# train runs (they declare train) fail with "no result file", one row per family and method.
+NO_2D_TRAIN_ROWS = {(family, method, "train"): n
+                    for family, n in (("skyscraper", 2), ("l_shaped", 1), ("all", 3))
+                    for method in ("2D-S", "2D-SS")}
+
+
 def _rows_by_key(path):
     rows = read_csv_rows(path.read_text())
     return {(r["family"], r["method"], r["protocol"]): r for r in rows}
@@ -58,7 +65,10 @@ def test_table2_reproduces_the_hand_computed_errors(compared):
             else:
                 got = (float(row[f"{name}_mean"]), float(row[f"{name}_std"]))
                 assert got == pytest.approx(stat, abs=TOL), (key, name)
-    assert set(t2) == {("all", "2D-SS", "ideal"), ("all", "neural3d", "train")}
+    assert set(t2) == {("all", "2D-SS", "ideal"), ("all", "neural3d", "train"),
+                       *NO_2D_TRAIN_ROWS}
+    for key, n in NO_2D_TRAIN_ROWS.items():  # every 2D train run failed: no result file
+        assert (int(t2[key]["buildings"]), int(t2[key]["failed"])) == (n, n), key
 
 
 def test_table3_lists_footprint_methods_with_failures(compared):
@@ -79,8 +89,13 @@ def test_failures_are_reported_with_reasons(compared):
     assert "failed: l_shaped / neural3d / train: ell_c: no result file" in md
     assert "ell_c: corrupt result file" in stdout
     rows = read_building_errors_csv(out / "per_building.csv")
-    failed = [(r.scene, r.method) for r in rows if r.status == "failed"]
-    assert failed == [("ell_c", "2D-SS"), ("ell_c", "neural3d")]
+    failed = [(r.scene, r.method, r.protocol) for r in rows if r.status == "failed"]
+    assert failed == [("ell_c", "2D-S", "train"), ("ell_c", "2D-SS", "ideal"),
+                      ("ell_c", "2D-SS", "train"), ("ell_c", "neural3d", "train"),
+                      ("sky_a", "2D-S", "train"), ("sky_a", "2D-SS", "train"),
+                      ("sky_b", "2D-S", "train"), ("sky_b", "2D-SS", "train")]
+    assert all(r.reason.startswith("no result file") for r in rows
+               if r.status == "failed" and r.protocol == "train")
 
 
 def test_stdout_has_both_tables(compared):
@@ -94,7 +109,7 @@ def test_every_output_records_its_provenance(compared):
     prov = json.loads((out / "provenance.json").read_text())
     assert prov["code_version"] and prov["data"].endswith("data")
     assert set(prov["methods"]) == {"2D-S", "2D-SS", "neural3d"}
-    assert len(prov["runs"]) == 9
+    assert len(prov["runs"]) == 15  # 3 scenes x (2D-S, 2D-SS on ideal and train; neural3d)
     for name in ("table2_errors.csv", "table3_footprint_iou.csv", "per_building.csv"):
         assert (out / name).read_text().startswith("# produced by `python -m metrics.compare")
     assert (out / "table2_errors.tex").read_text().startswith("% produced by")
@@ -114,9 +129,13 @@ def test_plots_footprints_and_pointers_are_written(compared):
 def test_per_facade_rows(compared):
     out, _ = compared
     rows = read_csv_rows((out / "per_facade.csv").read_text())
-    # ell_c's failed runs (a corrupt file, no file) missed both of its facades
-    missed = [(r["scene"], r["method"], r["facade_id"]) for r in rows if r["kind"] == "missed"]
-    assert missed == [("ell_c", m, f) for m in ("2D-SS", "neural3d") for f in ("1", "2")]
+    # failed runs (ell_c's corrupt file, the missing files) missed all of their facades
+    missed = [(r["scene"], r["method"], r["protocol"], r["facade_id"]) for r in rows
+              if r["kind"] == "missed"]
+    failed_runs = [("ell_c", "2D-S", "train"), ("ell_c", "2D-SS", "ideal"),
+                   ("ell_c", "2D-SS", "train"), ("ell_c", "neural3d", "train"),
+                   *((s, m, "train") for s in ("sky_a", "sky_b") for m in ("2D-S", "2D-SS"))]
+    assert missed == [(*run, f) for run in failed_runs for f in ("1", "2")]
     assert all(r["status"] == "failed" for r in rows if r["kind"] == "missed")
     matched = [r for r in rows if r["kind"] == "matched"]
     assert [(r["scene"], r["facade_id"]) for r in matched] == [("sky_a", "1"), ("sky_a", "2")]

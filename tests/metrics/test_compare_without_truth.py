@@ -2,7 +2,8 @@
 never errors, and says so; a folder mixing both is scored over the scenes with truth.
 
 The scenes are the rendered box building (``clean_scene``) with and without its
-``building.json``; the 2D methods run on its ideal views. The estimates on the copy without
+``building.json``; the 2D methods run on its ideal views (on a copy with orbit frames only,
+what a photos scene is, on its ``train`` views). The estimates on the copy without
 truth must equal those of the same methods on the copy with it: the truth is never read by a
 method, only by the scoring.
 """
@@ -126,6 +127,26 @@ def test_a_mixed_folder_is_scored_over_the_scenes_with_truth(clean_scene, tmp_pa
     assert all(r["orientation"] != "" for r in facades if r["building"] == "box")
     page = (out / REPORT_FILE).read_text()
     assert "Table 2: errors per family" in page and "photos have none: estimates only" in page
+
+
+@pytest.mark.slow  # a whole comparison with its outputs (about 2 s)
+def test_the_2d_methods_measure_a_scene_of_orbit_frames_only(clean_scene, tmp_path):
+    """What a photos scene is (docs/importing.md section 9): `train` frames only, no facade
+    ids, no truth. With `--views train` both 2D methods run on it (they declare `train`),
+    find their own facades and give their normals to the exports."""
+    scene = _scene(clean_scene, tmp_path / "orbit", "box", truth=False)
+    meta = json.loads((scene / "transforms.json").read_text())
+    meta["frames"] = [f for f in meta["frames"] if f["split"] == "train"]
+    assert meta["frames"] and all(f.get("facade_id") is None for f in meta["frames"])
+    (scene / "transforms.json").write_text(json.dumps(meta))
+    comparison, out = _compare(tmp_path / "orbit", tmp_path, views=("train",))
+    rows = [dict(zip(comparison.estimates.keys, r)) for r in comparison.estimates.rows]
+    assert [(r["method"], r["protocol"], r["status"]) for r in rows] == [
+        ("2D-S", "train", "ok"), ("2D-SS", "train", "ok")], [r["reason"] for r in rows]
+    assert all(r["facades"] >= 1 for r in rows)
+    facades = read_csv_rows((out / EXPORT_FOLDER / "facades.csv").read_text())
+    assert {r["method"] for r in facades} == {"2D-S", "2D-SS"}
+    assert all(r["azimuth_from"] == "estimate normal" for r in facades if r["wwr"] != "")
 
 
 def test_a_method_needing_depth_is_refused_per_building_with_its_reason(clean_scene, tmp_path):

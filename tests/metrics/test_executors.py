@@ -111,7 +111,7 @@ def test_2d_methods_give_the_same_tables_with_ray_and_local(local_ray, tiny_benc
                         for f in ("table2_errors.csv", "table3_footprint_iou.csv")}
         tables[name]["results"] = [replace(read_result(p), wall_time_s=0.0)
                                    for p in sorted(results.glob("*.json"))]
-    assert len(tables["local"]["results"]) == 3 * 2 * 2
+    assert len(tables["local"]["results"]) == 3 * 2 * 3  # scenes x methods x ideal,multi,train
     assert tables["ray"] == tables["local"]  # CSV bodies byte for byte, every result field
 
 
@@ -277,7 +277,8 @@ def test_ctrl_c_stops_the_cli_with_whole_results_only(tiny_benchmark, tmp_path):
     assert proc.returncode == 130, stderr
     assert "interrupted" in stderr
     written = sorted(p for p in results.iterdir() if p.is_file())
-    assert written and all(p.name.endswith("__2D-S__ideal.json") for p in written)
+    assert written and all(p.name.endswith(("__2D-S__ideal.json", "__2D-S__train.json"))
+                           for p in written)
     for path in written:  # whole files only: each reads back
         read_result(path)
     runs = results / "neural3d_runs"

@@ -140,7 +140,8 @@ def test_report_in_headless_chromium(compared, tmp_path):
             assert not section.is_visible()
             button.click()
             assert section.is_visible()
-            assert section.locator("table tbody tr").count() == 5  # 2D-S, 2D-SS x 2 views; neural3d
+            # 2D-S, 2D-SS x 3 views (ideal, multi, train); neural3d (train)
+            assert section.locator("table tbody tr").count() == 7
             assert section.locator("svg path").count() >= 2  # truth + an estimate
             page.wait_for_selector(f'section.building[data-scene="{scene}"] .mesh-wrap canvas',
                                    timeout=30_000)

@@ -20,7 +20,7 @@ def test_specs_carry_the_configs_the_methods_run_with(tmp_path):
                              preset="tiny", steps=300, max_minutes=1.5, resolution=96,
                              eval_frames=1)})
     s2ds, s2dss, n3d = specs
-    assert (s2ds.protocols, s2ds.config) == (("ideal",), asdict(Wwr2dsConfig()))
+    assert (s2ds.protocols, s2ds.config) == (("ideal", "train"), asdict(Wwr2dsConfig()))
     assert s2dss.config == asdict(Wwr2dssConfig())
     assert n3d.protocols == ("train",) and n3d.has_footprint
     assert n3d.config["budget"] == {"preset": "tiny", "steps": 300, "max_seconds": 90.0,
@@ -45,9 +45,11 @@ def test_views_choose_the_protocols_each_method_declares(tmp_path):
     def protocols(views):
         return {s.name: s.protocols for s in method_specs(("2D-S", "neural3d"), views, tmp_path)}
 
-    assert protocols(DEFAULT_PROTOCOLS) == {"2D-S": ("ideal", "multi"), "neural3d": ("train",)}
+    assert protocols(DEFAULT_PROTOCOLS) == {"2D-S": ("ideal", "multi", "train"),
+                                            "neural3d": ("train",)}
+    assert protocols(("train",)) == {"2D-S": ("train",), "neural3d": ("train",)}
     assert protocols(("street",)) == {"2D-S": ("street",), "neural3d": ("street",)}
-    assert protocols(("ideal", "street")) == {"2D-S": ("ideal", "street"),
+    assert protocols(("street", "ideal")) == {"2D-S": ("ideal", "street"),
                                               "neural3d": ("street",)}
 
 

@@ -13,7 +13,7 @@ from envelope.provenance import make_provenance, provenance_changes
 from envelope.results import read_result
 from metrics.compare import main
 from metrics.report.report import read_building_errors_csv
-from metrics.report.robustness_plot import plot_robustness
+from metrics.report.robustness_plot import RobustnessRow, plot_robustness
 from metrics.robustness import RobustnessStudy, robustness_table, summarise
 from metrics.run.degraded import CONFIG_KEY, with_degradation
 from metrics.run.runner import folder_spec
@@ -44,6 +44,23 @@ def test_plot_has_one_panel_per_degradation(tmp_path) -> None:
     with pytest.raises(ValueError):
         plot_robustness(summarise([_row("a", "2D-S", None, "failed")], "pose", 1.0),
                         tmp_path / "none")
+
+
+def test_every_method_and_views_gets_a_curve(tmp_path, monkeypatch) -> None:
+    """More curves than markers (both 2D methods on four protocols, neural3d on two): none is
+    left out of the plot."""
+    import metrics.report.robustness_plot as robustness_plot
+
+    series = [(m, p) for m in ("2D-S", "2D-SS") for p in ("ideal", "multi", "train", "street")]
+    series += [("neural3d", "train"), ("neural3d", "street")]
+    rows = [RobustnessRow("pose", s, m, p, 1, 0, 1.0 + s, None, None)
+            for m, p in series for s in (0.0, 1.0)]
+    drawn = []
+    monkeypatch.setattr(robustness_plot, "save_figure",
+                        lambda fig, stem: drawn.append(fig) or [])
+    plot_robustness(rows, tmp_path / "robustness")
+    (ax,) = drawn[0].axes
+    assert [line.get_label() for line in ax.get_lines()] == [f"{m} ({p})" for m, p in series]
 
 
 def test_study_rejects_bad_levels() -> None:

@@ -210,8 +210,9 @@ def test_ctrl_c_stops_the_trainings_with_checkpoints_and_whole_results(
     assert proc.returncode == 130, stderr
     assert time.monotonic() - tic < 60 and "interrupted" in stderr
     written = sorted(p for p in results.iterdir() if p.is_file())
-    assert [p.name for p in written] == [f"{s.name}__2D-S__ideal.json"
-                                         for s in find_scene_folders(tiny_benchmark)]
+    assert [p.name for p in written] == [f"{s.name}__2D-S__{protocol}.json"  # light runs first
+                                         for s in find_scene_folders(tiny_benchmark)
+                                         for protocol in ("ideal", "train")]
     for path in written:
         read_result(path)
     started = [p for p in runs.iterdir() if (p / "config.json").exists()]

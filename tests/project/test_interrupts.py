@@ -113,5 +113,6 @@ def test_compare_interrupted_then_rerun(sig, seed, clean_scene, tmp_path):
     assert sig == signal.SIGKILL or not list(results.glob(".*.tmp"))
     done = _rerun(argv)
     assert done.returncode == 0, done.stderr
-    assert len([read_result(p) for p in results.glob("*.json")]) == 2 * 2 * 2
+    # scenes x methods x the default views (ideal, multi, train)
+    assert len([read_result(p) for p in results.glob("*.json")]) == 2 * 2 * 3
     assert (tmp_path / "cmp" / "provenance.json").is_file()

@@ -5,6 +5,8 @@ import contextlib
 import io
 import shutil
 import sys
+from dataclasses import replace
+from pathlib import Path
 
 import pytest
 from segment_plugin import install_toy_plugin
@@ -35,11 +37,16 @@ def test_keys_name_the_segmenter_and_its_weights():
 
 
 def test_only_the_splits_the_methods_read_are_segmented():
-    def spec(*protocols):
-        return folder_spec("m", protocols, {}, run=len)
+    def spec(*protocols, trained=False):
+        made = folder_spec("m", protocols, {}, run=len)
+        return replace(made, artefacts_dir=Path("runs")) if trained else made
 
     assert splits_read([spec("ideal", "multi")]) == ("ideal", "multi")
-    assert splits_read([spec("ideal"), spec("train")]) == ("eval", "ideal", "train")
+    # the held-out orbit views only for a trained method (a run folder) on the orbit
+    assert splits_read([spec("ideal", "train")]) == ("ideal", "train")
+    assert splits_read([spec("ideal"), spec("train", trained=True)]) == (
+        "eval", "ideal", "train")
+    assert splits_read([spec("ideal", trained=True), spec("train")]) == ("ideal", "train")
     assert splits_read([]) == ()
 
 
