@@ -6,10 +6,11 @@ Copies the RGB images of one split of a rendered scene into a folder of photos (
 ``bench/photos_from_renders.py`` does, :func:`dataset.importers.photos.stripped_renders.
 strip_renders`), runs the photos source's structure from motion on them
 (:func:`dataset.importers.photos.sfm.reconstruct`, its database and models kept under
-``--work``; given a ``--work`` that holds them, it reads them again) and reports: every model COLMAP made, with its photos and their pose errors
-against the truth after the best similarity (rotation deg, position m); the SIFT keypoints
-per photo; and, for each two models, the verified pairs (photo, photo, inlier matches,
-COLMAP's two-view configuration) that join a photo of one to a photo of the other alone.
+``--work``; given a ``--work`` that holds them, it reads them again) and reports: every
+model COLMAP made, with its photos and their pose errors against the truth after the best
+similarity (rotation deg, position m); the SIFT keypoints per photo; and, for each two
+models, the verified pairs (photo, photo, inlier matches, COLMAP's two-view configuration)
+that join a photo of one to a photo of the other alone.
 A diagnosis aid: it reads the truth, which the photos source never does.
 """
 
@@ -67,7 +68,8 @@ def main(argv: list[str] | None = None) -> int:
                                                    .cam_from_world().matrix())
                               for n in names_sorted])
         e = pose_errors(recovered, np.stack([truth[n] for n in names_sorted]))
-        print(f"| {k} | {len(names)} | {' '.join(Path(n).stem.split('_')[-1] for n in names_sorted)}"
+        which = " ".join(Path(n).stem.split("_")[-1] for n in names_sorted)
+        print(f"| {k} | {len(names)} | {which}"
               f" | {np.median(e.rotation_deg):.3f} / {e.rotation_deg.max():.3f}"
               f" | {np.median(e.position_m):.3f} / {e.position_m.max():.3f} |")
     db = pycolmap.Database.open(str(args.work / "database.db"))
