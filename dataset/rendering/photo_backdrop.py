@@ -18,12 +18,12 @@ import numpy as np
 
 from dataset.rendering.look import Look
 from dataset.rendering.noise import detail, value_noise
+from dataset.rendering.photo_look import HAZE_DISTANCE_M
 
 BACKDROP_GAP_M = 30.0
 """The belt's distance outside the scene's bounding box in plan (half its diagonal)."""
 TREE_HEIGHT_M = (7.0, 21.0)
 """Lowest and highest top of the tree line."""
-HAZE_DISTANCE_M = 1500.0  # contrast falls to 1/e at this distance, as the ground's
 
 _FOLIAGE_DARK_RGB = np.array([0.10, 0.16, 0.07]) ** 2.2
 _FOLIAGE_LIGHT_RGB = np.array([0.34, 0.40, 0.18]) ** 2.2
