@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 
-from dataset.rendering import photo_look
+from dataset.rendering import photo_backdrop, photo_look
 from dataset.rendering.look import Look
 from dataset.rendering.noise import detail, hash01, value_noise
 from dataset.rendering.textures import TextureSet, texture_albedo
@@ -189,6 +189,10 @@ def shade(
         ground = miss & (d_unit[:, 2] < 0) & (origins_m[:, 2] > 0)
         out[ground] = photo_look.ground_radiance(raycaster, origins_m[ground], d_unit[ground],
                                                  look, photo, pixel_angle_rad)
+        far = np.flatnonzero(miss)
+        trees, radiance = photo_backdrop.backdrop_radiance(
+            origins_m[far], d_unit[far], raycaster.bounds_m, look, pixel_angle_rad)
+        out[far[trees]] = radiance
     hit = np.flatnonzero(~miss)
     if len(hit) == 0:
         return out
@@ -332,6 +336,9 @@ def _glass(
         mirror[down] = photo_look.ground_radiance(
             photo.raycaster, photo.points_m[down], reflected[down], look, photo.materials,
             photo.pixel_angle_rad)
+        trees, radiance = photo_backdrop.backdrop_radiance(
+            photo.points_m, reflected, photo.raycaster.bounds_m, look, photo.pixel_angle_rad)
+        mirror[trees] = radiance
         interior = photo_look.window_interior(s, v, interior, irradiance, look, photo.materials,
                                               photo.footprint_m)
     return fresnel * (mirror + glint * look.sun_rgb) + (1 - fresnel) * interior
