@@ -12,6 +12,7 @@ written into a temporary folder renamed when complete, so a failure leaves nothi
 
 from __future__ import annotations
 
+import sys
 import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -39,6 +40,7 @@ from dataset.importers.photos.posed import (
     undistorted_rgb,
 )
 from dataset.importers.photos.sfm import SfmConfig, reconstruct
+from dataset.importers.photos.stage_times import METRIC_FRAME, READING, WRITING, StageTimes
 from dataset.importers.source import SceneEntry, Source
 from envelope.photo_io import read_photo_rgb
 from envelope.protocols import TRAIN_PROTOCOL
@@ -48,6 +50,8 @@ from envelope.scenes.scene import write_transforms
 JPEG_QUALITY = 95
 """Undistorted JPEG photos are written again as JPEG at this quality (PNG stays PNG)."""
 RECORD_KEY = "photos"
+SECONDS_KEY = "seconds"
+"""The record's entry of seconds per stage (:mod:`dataset.importers.photos.stage_times`)."""
 
 
 @dataclass(frozen=True)
@@ -75,12 +79,12 @@ def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, .
     if options.scale is None:
         raise ValueError(NO_SCALE)
     if colmap_model_folder(path) is not None:
-        return (SceneEntry(path.resolve().name, partial(_write, read_colmap_project, path,
-                                                        options)),)
+        return (SceneEntry(path.resolve().name, partial(
+            _write, partial(_read_posed, read_colmap_project), path, options)),)
     if transforms_file(path) is not None:
         folder = path if path.is_dir() else path.parent
-        return (SceneEntry(folder.resolve().name, partial(_write, read_nerfstudio, path,
-                                                          options)),)
+        return (SceneEntry(folder.resolve().name, partial(
+            _write, partial(_read_posed, read_nerfstudio), path, options)),)
     photos = list_photos(path)
     known = options.scale.known_distance
     missing = [] if known is None else [n for n in (known.photo_a, known.photo_b)
@@ -107,16 +111,24 @@ def detect_photos(path: str | Path) -> bool:
         return False
 
 
+def _read_posed(read: Callable[[Path], PosedPhotos], path: Path,
+                times: StageTimes) -> PosedPhotos:
+    with times.stage(READING):
+        return read(path)
+
+
 def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
-                           path: Path) -> PosedPhotos:
+                           path: Path, times: StageTimes) -> PosedPhotos:
     with tempfile.TemporaryDirectory(prefix="photos-sfm-") as work:
         upright = Path(work) / "upright"
         upright.mkdir()
-        for photo in photos:
-            # Every photo is decoded here, before COLMAP sees it: a broken file stops the run.
-            Image.fromarray(read_photo_rgb(photo.path)).save(upright / photo.name,
-                                                             format="PNG", compress_level=1)
-        model = reconstruct(photos, upright, Path(work), config)
+        with times.stage(READING):
+            for photo in photos:
+                # Every photo is decoded here, before COLMAP sees it: a broken file stops the
+                # run.
+                Image.fromarray(read_photo_rgb(photo.path)).save(upright / photo.name,
+                                                                 format="PNG", compress_level=1)
+        model = reconstruct(photos, upright, Path(work), config, times)
         posed = from_reconstruction(model, upright, upright=True)
         # The upright copies go with the temporary folder: point back at the photos.
         posed = tuple(replace(p, path=path / p.name) for p in posed)
@@ -129,30 +141,37 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                                 round(float(model.compute_mean_reprojection_error()), 4)})
 
 
-def _write(read: Callable[[Path], PosedPhotos], path: Path, options: PhotosOptions,
-           out_dir: Path) -> Scene:
-    """Pose the photos of ``path`` with ``read``, take them to metres and z up, and write
-    the scene into ``out_dir``."""
-    posed = read(path)
+def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
+           options: PhotosOptions, out_dir: Path) -> Scene:
+    """Pose the photos of ``path`` with ``read`` (which times its own stages), take them to
+    metres and z up, and write the scene into ``out_dir``."""
+    times = StageTimes()
+    posed = read(path, times)
     names = [p.name for p in posed.photos]
     if len(set(names)) != len(names):
         raise ValueError(f"{path}: two images share a file name; rename them")
-    similarity, frame_record = metric_similarity(
-        np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
-        options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
-        if options.scale.gps else None)
+    with times.stage(METRIC_FRAME):
+        similarity, frame_record = metric_similarity(
+            np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
+            options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
+            if options.scale.gps else None)
     (out_dir / "images").mkdir()
     frames = []
-    for photo in tqdm(posed.photos, desc="photos", unit="photo", disable=not options.progress):
-        rgb, intrinsics = undistorted_rgb(photo)
-        relative = f"images/{photo.name}"
-        jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
-        Image.fromarray(rgb).save(out_dir / relative, **(
-            {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
-        frames.append(Frame(relative, similarity.pose(photo.world_from_camera), intrinsics,
-                            TRAIN_PROTOCOL))
+    with times.stage(WRITING):
+        for photo in tqdm(posed.photos, desc="photos", unit="photo",
+                          disable=not options.progress):
+            rgb, intrinsics = undistorted_rgb(photo)
+            relative = f"images/{photo.name}"
+            jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
+            Image.fromarray(rgb).save(out_dir / relative, **(
+                {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
+            frames.append(Frame(relative, similarity.pose(photo.world_from_camera), intrinsics,
+                                TRAIN_PROTOCOL))
+    if options.progress:
+        print(f"{path.name}: {len(frames)} photos posed; {times.summary()}", file=sys.stderr)
     record = {**posed.record, **frame_record, "posed": len(frames),
-              "unposed": list(posed.unposed), "scale_factor": similarity.scale}
+              "unposed": list(posed.unposed), "scale_factor": similarity.scale,
+              SECONDS_KEY: times.record()}
     scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
     write_transforms(out_dir, scene)
     return scene
