@@ -13,9 +13,9 @@ them), strips them to JPEG photos with camera EXIF
 ``--known-distance`` between the first photo and the one farthest from it
 (:func:`~dataset.importers.photos.stripped_renders.known_pair`). Rendering is setup, not
 part of the timed path: the table's seconds are the photos source's own stages
-(:mod:`dataset.importers.photos.stage_times`), read from the scene's ``photos`` record, and
-"CPU s" the CPU seconds the process spent in them (threads included), which the other load
-on shared cores does not change. ``--views N`` poses N of the 100 views, evenly spaced (a
+(:mod:`dataset.importers.photos.stage_times`), read from the scene's ``photos`` record: wall
+seconds, and in brackets the CPU seconds the process spent in them (threads included), which
+other work on shared cores does not change. ``--views N`` poses N of the 100 views, evenly spaced (a
 quick run). ``--max-image-px`` and ``--max-features`` set the structure-from-motion options
 of :class:`dataset.importers.photos.sfm.SfmConfig` (default: its defaults). With ``--photos
 DIR`` (a folder of photos) it poses those instead, with a stand-in ``--known-height`` of
@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import resource
 import shutil
 import sys
 import time
@@ -43,19 +42,19 @@ from dataset.importers.photos.metric_frame import ScaleHint  # noqa: E402
 from dataset.importers.photos.photo_folder import list_photos  # noqa: E402
 from dataset.importers.photos.pose_error import pose_errors  # noqa: E402
 from dataset.importers.photos.sfm import SfmConfig  # noqa: E402
-from dataset.importers.photos.source import (  # noqa: E402
-    RECORD_KEY,
+from dataset.importers.photos.source import RECORD_KEY, PhotosOptions, read_photos  # noqa: E402
+from dataset.importers.photos.stage_times import (  # noqa: E402
+    CPU_SECONDS_KEY,
     SECONDS_KEY,
-    PhotosOptions,
-    read_photos,
+    STAGES,
+    TOTAL_KEY,
 )
-from dataset.importers.photos.stage_times import STAGES, TOTAL_KEY  # noqa: E402
 from dataset.importers.photos.stripped_renders import (  # noqa: E402
     known_pair,
     strip_renders,
     stripped_poses,
 )
-from dataset.importers.source import NoOptions, write_scenes  # noqa: E402
+from dataset.importers.source import BuildingEntry, NoOptions, write_scenes  # noqa: E402
 from dataset.rendering.context import ViewMeshes  # noqa: E402
 from dataset.rendering.orbit_views import (  # noqa: E402
     OrbitConfig,
@@ -81,43 +80,43 @@ STRIP_ROWS = 375
 time in the kernel; strips of 375 rows give the same pixels (the shading is per ray)."""
 HEIGHT_STAND_IN_M = 10.0
 """``--photos``' scale: any scale poses the photos in the same time."""
-COLUMNS = ("photos", "pixels", "posed", *(s.label for s in STAGES), "total s", "CPU s",
+COLUMNS = ("photos", "pixels", "posed", *(s.label for s in STAGES), "total s",
            "rotation deg (median / max)", "position m (median / max)", "scale error %")
 
 
-def render_capture(scene_dir: Path, workers: int) -> Path:
-    """Render the capture (module docstring) into the scene folder ``scene_dir`` (RGB images
-    and ``transforms.json`` only); views already there are kept, so a stopped render resumes."""
-    if (scene_dir / "transforms.json").is_file():
-        return scene_dir
+def render_views(images_dir: Path, entry: BuildingEntry, seed: int, frames: list[Frame],
+                 workers: int) -> None:
+    """Render the RGB image of each of ``frames`` not yet in ``images_dir`` (each written
+    whole or not at all, so a stopped render resumes), in ``workers`` processes."""
+    images_dir.mkdir(parents=True, exist_ok=True)
+    todo = [(entry, seed, images_dir, f) for f in frames
+            if not (images_dir / Path(f.file_path).name).is_file()]
+    if not todo:
+        return
+    start = time.perf_counter()
+    with worker_pool(workers) as pool:
+        for done, name in enumerate(pool.imap(_render_frame, todo), 1):
+            print(f"rendered {name} ({done}/{len(todo)}, {time.perf_counter() - start:.0f} s)",
+                  file=sys.stderr)
+
+
+def planned_capture() -> tuple[BuildingEntry, int, list[Frame]]:
+    """The building's preset entry, its seed and the capture's frames (module docstring),
+    in the order of their bearing from the building's centre."""
     entry, = (e for e in PRESET_SOURCE.read(PRESET, NoOptions()) if e.name == BUILDING)
     building = entry.build()
     seed = scene_seed(0, entry.seed) if entry.seed is not None else 0
     k = Intrinsics.from_fov(WIDTH_PX, HEIGHT_PX, GenerateConfig().fov_deg)
-    meshes = ViewMeshes(building, context=False)
-    poses = sample_orbit_views(building, meshes.alone, k, PHOTOS, config=OrbitConfig(),
-                               seed=seed)
-    centre = point_of_interest_m(meshes.alone)
+    caster = ViewMeshes(building, context=False).alone
+    poses = sample_orbit_views(building, caster, k, PHOTOS, config=OrbitConfig(), seed=seed)
+    centre = point_of_interest_m(caster)
     poses.sort(key=lambda p: float(np.arctan2(*(p[:2, 3] - centre[:2])[::-1])))
-    (scene_dir / "images").mkdir(parents=True, exist_ok=True)
-    frames = [Frame(f"images/{TRAIN_PROTOCOL}_{i:04d}.png", pose, k, TRAIN_PROTOCOL)
-              for i, pose in enumerate(poses)]
-    # Every fourth view first, then every second, then the rest: a stopped render leaves
-    # views spread round the building, which --views 25 or 50 poses.
-    order = sorted(range(PHOTOS), key=lambda i: (i % 4 != 0, i % 2 != 0, i))
-    todo = [(entry, seed, scene_dir, frames[i]) for i in order
-            if not (scene_dir / frames[i].file_path).is_file()]
-    start = time.perf_counter()
-    with worker_pool(workers) as pool:
-        for done, name in enumerate(pool.imap_unordered(_render_frame, todo), 1):
-            print(f"rendered {name} ({done}/{len(todo)}, {time.perf_counter() - start:.0f} s)",
-                  file=sys.stderr)
-    write_transforms(scene_dir, Scene(scene_dir, tuple(frames)))
-    return scene_dir
+    return entry, seed, [Frame(f"images/{TRAIN_PROTOCOL}_{i:04d}.png", pose, k, TRAIN_PROTOCOL)
+                         for i, pose in enumerate(poses)]
 
 
 def _render_frame(job: tuple) -> str:
-    entry, seed, scene_dir, frame = job
+    entry, seed, images_dir, frame = job
     meshes = ViewMeshes(entry.build(), context=False)
     k = frame.intrinsics
     strips = []
@@ -126,40 +125,40 @@ def _render_frame(job: tuple) -> str:
         strips.append(render_view(meshes.rendered, strip_k, frame.world_from_camera,
                                   config=RgbConfig(look="photo"), seed=seed,
                                   textures=meshes.textures)[1])
-    path = scene_dir / frame.file_path
+    path = images_dir / Path(frame.file_path).name
     partial = path.with_suffix(".partial.png")
     write_rgb(partial, np.concatenate(strips))
     os.replace(partial, path)
     return path.name
 
 
-def pose_capture(photos_dir: Path, out_root: Path, scale: ScaleHint, sfm: SfmConfig) -> dict:
+def pose_capture(photos_dir: Path, out_root: Path, scale: ScaleHint,
+                 sfm: SfmConfig) -> tuple[Path, dict]:
     """Run the photos source on ``photos_dir`` into ``out_root`` (replaced); return the
-    scene's ``photos`` record with ``cpu_s`` added (the process's CPU seconds, its threads
-    included: on shared cores the wall seconds depend on the load, these do not)."""
-    cpu_start = _cpu_s()
+    scene folder and its ``photos`` record."""
     scene_dir, = write_scenes(read_photos(photos_dir, PhotosOptions(scale=scale, sfm=sfm,
                                                                     progress=False)),
                               out_root, overwrite=True, progress=False)
-    record = read_scene(scene_dir).extra[RECORD_KEY]
-    return {**record, "cpu_s": _cpu_s() - cpu_start, "scene_dir": scene_dir}
+    return scene_dir, read_scene(scene_dir).extra[RECORD_KEY]
 
 
-def table_row(photos_dir: Path, record: dict, truth: dict[str, np.ndarray] | None) -> list[str]:
-    """One row of the table: the photos, their size, how many were posed, the seconds per
-    stage and the pose error (``truth``: the true poses by photo name, or ``None``)."""
+def table_row(photos_dir: Path, scene_dir: Path, record: dict,
+              truth: dict[str, np.ndarray] | None) -> list[str]:
+    """One row of the table: the photos, their size, how many were posed, the wall (and CPU)
+    seconds per stage and the pose error (``truth``: the true poses by photo name, or
+    ``None``)."""
     photos = list_photos(photos_dir)
     sizes = sorted({(p.width, p.height) for p in photos})
     megapixels = max(w * h for w, h in sizes) / 1e6
     pixels = ", ".join(f"{w} x {h}" for w, h in sizes) + f" ({megapixels:.1f} MP)"
-    seconds = record[SECONDS_KEY]
+    wall, cpu = record[SECONDS_KEY], record[CPU_SECONDS_KEY]
     posed = record["posed"]
     row = [str(len(photos)), pixels, f"{posed} ({100 * posed / len(photos):.0f} %)",
-           *(f"{seconds.get(s.key, 0.0):.0f}" for s in STAGES), f"{seconds[TOTAL_KEY]:.0f}",
-           f"{record['cpu_s']:.0f}"]
+           *(f"{wall.get(key, 0.0):.0f} ({cpu.get(key, 0.0):.0f})"
+             for key in [s.key for s in STAGES] + [TOTAL_KEY])]
     if truth is None:
         return row + ["-", "-", "-"]
-    frames = read_scene(record["scene_dir"]).frames
+    frames = read_scene(scene_dir).frames
     names = [Path(f.file_path).name for f in frames]
     e = pose_errors(np.stack([f.world_from_camera for f in frames]),
                     np.stack([truth[n] for n in names]))
@@ -169,32 +168,31 @@ def table_row(photos_dir: Path, record: dict, truth: dict[str, np.ndarray] | Non
 
 
 def stripped_capture(work: Path, workers: int, views: int) -> tuple[Path, dict[str, np.ndarray]]:
-    """The rendered capture's photos (``views`` of them, evenly spaced by bearing) stripped
-    into a folder under ``work`` (made once), and their true poses by photo name."""
-    scene_dir = render_capture(work / "renders" / BUILDING, workers)
+    """``views`` of the capture's photos (evenly spaced by bearing; module docstring), rendered
+    where they are not yet, stripped into a folder under ``work`` (made once); return it and
+    their true poses by photo name."""
+    entry, seed, frames = planned_capture()
+    # Every fourth view first, then every second, then the rest: a stopped render leaves
+    # views spread round the building, which --views 25 or 50 poses.
+    chosen = sorted({round(i * PHOTOS / views) for i in range(views)},
+                    key=lambda i: (i % 4 != 0, i % 2 != 0, i))
+    scene_dir = work / f"renders-{views}" / BUILDING  # a scene of the chosen views
     photos_dir = work / f"photos-{views}" / BUILDING
+    if not (scene_dir / "transforms.json").is_file():
+        images_dir = work / "renders" / BUILDING / "images"
+        render_views(images_dir, entry, seed, [frames[i] for i in chosen], workers)
+        (scene_dir / "images").mkdir(parents=True, exist_ok=True)
+        for i in chosen:
+            name = Path(frames[i].file_path).name
+            if not (scene_dir / "images" / name).is_file():
+                os.link(images_dir / name, scene_dir / "images" / name)
+        write_transforms(scene_dir, Scene(scene_dir, tuple(frames[i] for i in sorted(chosen))))
     if not photos_dir.is_dir():
-        keep = {f"{TRAIN_PROTOCOL}_{round(i * PHOTOS / views):04d}" for i in range(views)}
-        subset = work / f"renders-{views}" / BUILDING
-        if views != PHOTOS and not subset.is_dir():
-            scene = read_scene(scene_dir)
-            frames = tuple(f for f in scene.frames if Path(f.file_path).stem in keep)
-            (subset / "images").mkdir(parents=True)
-            for f in frames:
-                os.link(scene.path(f.file_path), subset / f.file_path)
-            write_transforms(subset, Scene(subset, frames))
         partial = photos_dir.with_name(photos_dir.name + ".partial")
         shutil.rmtree(partial, ignore_errors=True)
-        strip_renders(scene_dir if views == PHOTOS else subset, partial, (TRAIN_PROTOCOL,))
+        strip_renders(scene_dir, partial, (TRAIN_PROTOCOL,))
         partial.rename(photos_dir)
-    truth = stripped_poses(scene_dir, (TRAIN_PROTOCOL,))
-    return photos_dir, {name: pose for name, pose in truth.items()
-                        if (photos_dir / name).is_file()}
-
-
-def _cpu_s() -> float:
-    usage = resource.getrusage(resource.RUSAGE_SELF)
-    return usage.ru_utime + usage.ru_stime
+    return photos_dir, stripped_poses(scene_dir, (TRAIN_PROTOCOL,))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -223,11 +221,11 @@ def main(argv: list[str] | None = None) -> int:
         photos_dir, truth = args.photos, None
         scale = ScaleHint(known_height_m=HEIGHT_STAND_IN_M)
     load = os.getloadavg()[0]
-    record = pose_capture(photos_dir, args.work / "posed", scale, sfm)
+    scene_dir, record = pose_capture(photos_dir, args.work / "posed", scale, sfm)
     print(f"load average (1 min) {load:.1f} before, {os.getloadavg()[0]:.1f} after, on "
           f"{os.cpu_count()} cores; {sfm}", file=sys.stderr)
     print(markdown_table(f"Photos source on {photos_dir.name}", COLUMNS,
-                         [table_row(photos_dir, record, truth)]))
+                         [table_row(photos_dir, scene_dir, record, truth)]))
     return 0
 
 

@@ -12,15 +12,18 @@ written into a temporary folder renamed when complete, so a failure leaves nothi
 
 from __future__ import annotations
 
+import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+from PIL import ExifTags, Image
 from tqdm import tqdm
 
 from dataset.importers.photos.existing import (
@@ -31,9 +34,15 @@ from dataset.importers.photos.existing import (
 )
 from dataset.importers.photos.gps import read_gps_fix
 from dataset.importers.photos.gps_frame import check_photo_fixes
-from dataset.importers.photos.metric_frame import NO_SCALE, ScaleHint, metric_similarity
+from dataset.importers.photos.metric_frame import (
+    NO_SCALE,
+    ScaleHint,
+    Similarity,
+    metric_similarity,
+)
 from dataset.importers.photos.photo_folder import PHOTO_SUFFIXES, Photo, list_photos
 from dataset.importers.photos.posed import (
+    PosedPhoto,
     PosedPhotos,
     from_reconstruction,
     sparse_points,
@@ -50,8 +59,6 @@ from envelope.scenes.scene import write_transforms
 JPEG_QUALITY = 95
 """Undistorted JPEG photos are written again as JPEG at this quality (PNG stays PNG)."""
 RECORD_KEY = "photos"
-SECONDS_KEY = "seconds"
-"""The record's entry of seconds per stage (:mod:`dataset.importers.photos.stage_times`)."""
 
 
 @dataclass(frozen=True)
@@ -126,8 +133,12 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
             for photo in photos:
                 # Every photo is decoded here, before COLMAP sees it: a broken file stops the
                 # run.
-                Image.fromarray(read_photo_rgb(photo.path)).save(upright / photo.name,
-                                                                 format="PNG", compress_level=1)
+                rgb = read_photo_rgb(photo.path)
+                if _read_alike_by_colmap(photo.path):
+                    shutil.copyfile(photo.path, upright / photo.name)  # no encoding: faster
+                else:
+                    Image.fromarray(rgb).save(upright / photo.name, format="PNG",
+                                              compress_level=1)
         model = reconstruct(photos, upright, Path(work), config, times)
         posed = from_reconstruction(model, upright, upright=True)
         # The upright copies go with the temporary folder: point back at the photos.
@@ -139,6 +150,14 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                             "incremental mapping, SIFT, exhaustive matching, CPU",
                             "mean_reprojection_error_px":
                                 round(float(model.compute_mean_reprojection_error()), 4)})
+
+
+def _read_alike_by_colmap(path: Path) -> bool:
+    """Whether COLMAP reads the file's pixels as :func:`read_photo_rgb` gives them: an 8-bit
+    RGB or grey JPEG or PNG stored upright (no EXIF orientation, or the identity)."""
+    with Image.open(path) as img:
+        return (img.format in ("JPEG", "PNG") and img.mode in ("RGB", "L")
+                and img.getexif().get(ExifTags.Base.Orientation, 1) == 1)
 
 
 def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
@@ -156,25 +175,29 @@ def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
             options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
             if options.scale.gps else None)
     (out_dir / "images").mkdir()
-    frames = []
-    with times.stage(WRITING):
-        for photo in tqdm(posed.photos, desc="photos", unit="photo",
-                          disable=not options.progress):
-            rgb, intrinsics = undistorted_rgb(photo)
-            relative = f"images/{photo.name}"
-            jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
-            Image.fromarray(rgb).save(out_dir / relative, **(
-                {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
-            frames.append(Frame(relative, similarity.pose(photo.world_from_camera), intrinsics,
-                                TRAIN_PROTOCOL))
+    threads = (os.cpu_count() or 1) if options.sfm.threads == -1 else options.sfm.threads
+    with times.stage(WRITING), ThreadPoolExecutor(threads) as pool:
+        # Threads: decoding, undistorting and encoding a photo leave Python's lock.
+        frames = list(tqdm(pool.map(partial(_write_photo, out_dir, similarity), posed.photos),
+                           total=len(posed.photos), desc="photos", unit="photo",
+                           disable=not options.progress))
     if options.progress:
         print(f"{path.name}: {len(frames)} photos posed; {times.summary()}", file=sys.stderr)
     record = {**posed.record, **frame_record, "posed": len(frames),
               "unposed": list(posed.unposed), "scale_factor": similarity.scale,
-              SECONDS_KEY: times.record()}
+              **times.record()}
     scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
     write_transforms(out_dir, scene)
     return scene
+
+
+def _write_photo(out_dir: Path, similarity: Similarity, photo: PosedPhoto) -> Frame:
+    rgb, intrinsics = undistorted_rgb(photo)
+    relative = f"images/{photo.name}"
+    jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
+    Image.fromarray(rgb).save(out_dir / relative, **(
+        {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
+    return Frame(relative, similarity.pose(photo.world_from_camera), intrinsics, TRAIN_PROTOCOL)
 
 
 PHOTOS_SOURCE = Source(

@@ -1,5 +1,6 @@
-"""Where the photos source's time goes: wall seconds per stage, recorded in the scene's
-``photos`` record (``seconds``) and printed, so a user sees what a large photo set costs.
+"""Where the photos source's time goes: wall and CPU seconds per stage, recorded in the
+scene's ``photos`` record (``seconds``, ``cpu_seconds``) and printed (wall), so a user sees
+what a large photo set costs.
 
 A folder of photos runs every stage; a COLMAP project or a nerfstudio file runs reading,
 the metric frame and writing (its poses are given).
@@ -30,30 +31,41 @@ WRITING = Stage("writing", "undistortion + writing s")
 STAGES = (READING, FEATURES, MATCHING, MAPPING, METRIC_FRAME, WRITING)
 """Every stage, in the order they run."""
 TOTAL_KEY = "total"
+SECONDS_KEY = "seconds"
+"""The record's entry of wall seconds per stage."""
+CPU_SECONDS_KEY = "cpu_seconds"
+"""The record's entry of CPU seconds per stage (the process's, its threads included): on
+cores shared with other work the wall seconds grow with the load, these do not."""
 
 
 @dataclass
 class StageTimes:
-    """Wall seconds spent in each stage so far (a stage entered twice adds up)."""
+    """Wall and CPU seconds spent in each stage so far (a stage entered twice adds up)."""
 
-    seconds: dict[Stage, float] = field(default_factory=dict)
+    wall_s: dict[Stage, float] = field(default_factory=dict)
+    cpu_s: dict[Stage, float] = field(default_factory=dict)
 
     @contextmanager
     def stage(self, stage: Stage) -> Iterator[None]:
         """Time the ``with`` block as ``stage``."""
-        start = time.perf_counter()
+        wall, cpu = time.perf_counter(), time.process_time()
         try:
             yield
         finally:
-            self.seconds[stage] = self.seconds.get(stage, 0.0) + time.perf_counter() - start
+            self.wall_s[stage] = self.wall_s.get(stage, 0.0) + time.perf_counter() - wall
+            self.cpu_s[stage] = self.cpu_s.get(stage, 0.0) + time.process_time() - cpu
 
-    def record(self) -> dict[str, float]:
-        """The ``seconds`` entry of the record: each stage that ran, by key, and their
-        ``total``, rounded to 0.01 s."""
-        ran = {s.key: round(self.seconds[s], 2) for s in STAGES if s in self.seconds}
-        return {**ran, TOTAL_KEY: round(sum(self.seconds.values()), 2)}
+    def record(self) -> dict[str, dict[str, float]]:
+        """The record's :data:`SECONDS_KEY` and :data:`CPU_SECONDS_KEY` entries: each stage
+        that ran, by key, and their ``total``, rounded to 0.01 s."""
+        return {SECONDS_KEY: _by_key(self.wall_s), CPU_SECONDS_KEY: _by_key(self.cpu_s)}
 
     def summary(self) -> str:
-        """One line for the terminal: each stage that ran and the total, in seconds."""
-        ran = ", ".join(f"{s.key} {self.seconds[s]:.1f}" for s in STAGES if s in self.seconds)
-        return f"seconds per stage: {ran}; {TOTAL_KEY} {sum(self.seconds.values()):.1f}"
+        """One line for the terminal: each stage that ran and the total, in wall seconds."""
+        ran = ", ".join(f"{s.key} {self.wall_s[s]:.1f}" for s in STAGES if s in self.wall_s)
+        return f"seconds per stage: {ran}; {TOTAL_KEY} {sum(self.wall_s.values()):.1f}"
+
+
+def _by_key(seconds: dict[Stage, float]) -> dict[str, float]:
+    ran = {s.key: round(seconds[s], 2) for s in STAGES if s in seconds}
+    return {**ran, TOTAL_KEY: round(sum(seconds.values()), 2)}
