@@ -148,6 +148,8 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                            tuple(p.name for p in photos if p.name not in placed),
                            {"input": "photos", "structure_from_motion": "COLMAP (pycolmap) "
                             "incremental mapping, SIFT, exhaustive matching, CPU",
+                            "sift_max_image_px": config.max_image_px,
+                            "sift_max_features": config.max_features,
                             "mean_reprojection_error_px":
                                 round(float(model.compute_mean_reprojection_error()), 4)})
 
