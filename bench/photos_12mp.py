@@ -8,18 +8,21 @@ Without ``--photos`` it renders, once (kept in ``--work``, resumed where it stop
 orbit views of 4000 x 3000 px of the tiny preset's ``tiny_l_shaped`` in the photo look
 (``dataset.rendering``; the default orbit's cameras, 60 degrees across, planned for the 4:3
 frame, named in the order of their bearing round the building as a walk round it takes
-them), strips them to JPEG photos with camera EXIF
+them; an orbit is what structure from motion posed best, docs/measurements/photo-look.md),
+strips them to JPEG photos with camera EXIF
 (:func:`dataset.importers.photos.stripped_renders.strip_renders`) and poses them with
 ``--known-distance`` between the first photo and the one farthest from it
 (:func:`~dataset.importers.photos.stripped_renders.known_pair`). Rendering is setup, not
-part of the timed path: the table's seconds are the photos source's own stages
+part of the timed path (about 27 CPU seconds a view, in ``--workers`` processes). The
+table's seconds are the photos source's own stages
 (:mod:`dataset.importers.photos.stage_times`), read from the scene's ``photos`` record: wall
-seconds, and in brackets the CPU seconds the process spent in them (threads included), which
-other work on shared cores does not change. ``--views N`` poses N of the 100 views, evenly spaced (a
-quick run). ``--max-image-px`` and ``--max-features`` set the structure-from-motion options
-of :class:`dataset.importers.photos.sfm.SfmConfig` (default: its defaults). With ``--photos
-DIR`` (a folder of photos) it poses those instead, with a stand-in ``--known-height`` of
-10 m (the scale does not change the time), and reports no pose error.
+seconds, and in brackets the CPU seconds the process spent in them (threads included),
+which other work on shared cores does not change. ``--views N`` poses N of the 100 views,
+evenly spaced (a quick run). ``--max-image-px`` and ``--max-features`` set the
+structure-from-motion options of :class:`dataset.importers.photos.sfm.SfmConfig` (default:
+its defaults). With ``--photos DIR`` (a folder of photos) it poses those instead, with a
+stand-in ``--known-height`` of 10 m (the scale does not change the time), and reports no
+pose error.
 """
 
 from __future__ import annotations
