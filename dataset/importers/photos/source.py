@@ -14,14 +14,18 @@ written into a temporary folder renamed when complete, so a failure leaves nothi
 
 from __future__ import annotations
 
+import os
+import shutil
+import sys
 import tempfile
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
+from PIL import ExifTags, Image
 from tqdm import tqdm
 
 from dataset.importers.photos.existing import (
@@ -32,16 +36,29 @@ from dataset.importers.photos.existing import (
 )
 from dataset.importers.photos.gps import read_gps_fix
 from dataset.importers.photos.gps_frame import check_photo_fixes
-from dataset.importers.photos.metric_frame import NO_SCALE, ScaleHint, metric_similarity
+from dataset.importers.photos.metric_frame import (
+    NO_SCALE,
+    ScaleHint,
+    Similarity,
+    metric_similarity,
+)
 from dataset.importers.photos.photo_depth import with_photo_depths
 from dataset.importers.photos.photo_folder import PHOTO_SUFFIXES, Photo, list_photos
 from dataset.importers.photos.posed import (
+    PosedPhoto,
     PosedPhotos,
     from_reconstruction,
     sparse_points,
     undistorted_rgb,
 )
 from dataset.importers.photos.sfm import SfmConfig, reconstruct
+from dataset.importers.photos.stage_times import (
+    DEPTH,
+    METRIC_FRAME,
+    READING,
+    WRITING,
+    StageTimes,
+)
 from dataset.importers.source import SceneEntry, Source
 from envelope.photo_io import read_photo_rgb
 from envelope.protocols import TRAIN_PROTOCOL
@@ -78,12 +95,12 @@ def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, .
     if options.scale is None:
         raise ValueError(NO_SCALE)
     if colmap_model_folder(path) is not None:
-        return (SceneEntry(path.resolve().name, partial(_write, read_colmap_project, path,
-                                                        options)),)
+        return (SceneEntry(path.resolve().name, partial(
+            _write, partial(_read_posed, read_colmap_project), path, options)),)
     if transforms_file(path) is not None:
         folder = path if path.is_dir() else path.parent
-        return (SceneEntry(folder.resolve().name, partial(_write, read_nerfstudio, path,
-                                                          options)),)
+        return (SceneEntry(folder.resolve().name, partial(
+            _write, partial(_read_posed, read_nerfstudio), path, options)),)
     photos = list_photos(path)
     known = options.scale.known_distance
     missing = [] if known is None else [n for n in (known.photo_a, known.photo_b)
@@ -110,16 +127,28 @@ def detect_photos(path: str | Path) -> bool:
         return False
 
 
+def _read_posed(read: Callable[[Path], PosedPhotos], path: Path,
+                times: StageTimes) -> PosedPhotos:
+    with times.stage(READING):
+        return read(path)
+
+
 def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
-                           path: Path) -> PosedPhotos:
+                           path: Path, times: StageTimes) -> PosedPhotos:
     with tempfile.TemporaryDirectory(prefix="photos-sfm-") as work:
         upright = Path(work) / "upright"
         upright.mkdir()
-        for photo in photos:
-            # Every photo is decoded here, before COLMAP sees it: a broken file stops the run.
-            Image.fromarray(read_photo_rgb(photo.path)).save(upright / photo.name,
-                                                             format="PNG", compress_level=1)
-        model = reconstruct(photos, upright, Path(work), config)
+        with times.stage(READING):
+            for photo in photos:
+                # Every photo is decoded here, before COLMAP sees it: a broken file stops the
+                # run.
+                rgb = read_photo_rgb(photo.path)
+                if _read_alike_by_colmap(photo.path):
+                    shutil.copyfile(photo.path, upright / photo.name)  # no encoding: faster
+                else:
+                    Image.fromarray(rgb).save(upright / photo.name, format="PNG",
+                                              compress_level=1)
+        model = reconstruct(photos, upright, Path(work), config, times)
         posed = from_reconstruction(model, upright, upright=True)
         # The upright copies go with the temporary folder: point back at the photos.
         posed = tuple(replace(p, path=path / p.name) for p in posed)
@@ -128,38 +157,61 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                            tuple(p.name for p in photos if p.name not in placed),
                            {"input": "photos", "structure_from_motion": "COLMAP (pycolmap) "
                             "incremental mapping, SIFT, exhaustive matching, CPU",
+                            "sift_max_image_px": config.max_image_px,
+                            "sift_max_features": config.max_features,
                             "mean_reprojection_error_px":
                                 round(float(model.compute_mean_reprojection_error()), 4)})
 
 
-def _write(read: Callable[[Path], PosedPhotos], path: Path, options: PhotosOptions,
-           out_dir: Path) -> Scene:
-    """Pose the photos of ``path`` with ``read``, take them to metres and z up, and write
-    the scene into ``out_dir``."""
-    posed = read(path)
+def _read_alike_by_colmap(path: Path) -> bool:
+    """Whether COLMAP reads the file's pixels as :func:`read_photo_rgb` gives them: an 8-bit
+    RGB or grey JPEG or PNG stored upright (no EXIF orientation, or the identity)."""
+    with Image.open(path) as img:
+        return (img.format in ("JPEG", "PNG") and img.mode in ("RGB", "L")
+                and img.getexif().get(ExifTags.Base.Orientation, 1) == 1)
+
+
+def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
+           options: PhotosOptions, out_dir: Path) -> Scene:
+    """Pose the photos of ``path`` with ``read`` (which times its own stages), take them to
+    metres and z up, and write the scene into ``out_dir``."""
+    times = StageTimes()
+    posed = read(path, times)
     names = [p.name for p in posed.photos]
     if len(set(names)) != len(names):
         raise ValueError(f"{path}: two images share a file name; rename them")
-    similarity, frame_record = metric_similarity(
-        np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
-        options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
-        if options.scale.gps else None)
+    with times.stage(METRIC_FRAME):
+        similarity, frame_record = metric_similarity(
+            np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
+            options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
+            if options.scale.gps else None)
     (out_dir / "images").mkdir()
-    frames = []
-    for photo in tqdm(posed.photos, desc="photos", unit="photo", disable=not options.progress):
-        rgb, intrinsics = undistorted_rgb(photo)
-        relative = f"images/{photo.name}"
-        jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
-        Image.fromarray(rgb).save(out_dir / relative, **(
-            {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
-        frames.append(Frame(relative, similarity.pose(photo.world_from_camera), intrinsics,
-                            TRAIN_PROTOCOL))
+    threads = (os.cpu_count() or 1) if options.sfm.threads == -1 else options.sfm.threads
+    with times.stage(WRITING), ThreadPoolExecutor(threads) as pool:
+        # Threads: decoding, undistorting and encoding a photo leave Python's lock.
+        frames = list(tqdm(pool.map(partial(_write_photo, out_dir, similarity), posed.photos),
+                           total=len(posed.photos), desc="photos", unit="photo",
+                           disable=not options.progress))
     record = {**posed.record, **frame_record, "posed": len(frames),
               "unposed": list(posed.unposed), "scale_factor": similarity.scale}
     scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
-    scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY)
+    with times.stage(DEPTH):
+        scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY)
+    scene = replace(scene, extra={**scene.extra, RECORD_KEY: {**scene.extra[RECORD_KEY],
+                                                              **times.record()}})
+    if options.progress:
+        print(f"{path.name}: {len(frames)} photos posed; {times.summary()}", file=sys.stderr)
     write_transforms(out_dir, scene)
     return scene
+
+
+def _write_photo(out_dir: Path, similarity: Similarity, photo: PosedPhoto) -> Frame:
+    rgb, intrinsics = undistorted_rgb(photo)
+    relative = f"images/{photo.name}"
+    jpeg = Path(photo.name).suffix.lower() in (".jpg", ".jpeg")
+    Image.fromarray(rgb).save(out_dir / relative, **(
+        {"format": "JPEG", "quality": JPEG_QUALITY} if jpeg else {"format": "PNG"}))
+    return Frame(relative, similarity.pose(photo.world_from_camera), intrinsics, TRAIN_PROTOCOL)
 
 
 PHOTOS_SOURCE = Source(

@@ -24,6 +24,7 @@ from dataset.importers.photos.pose_error import PoseErrors, pose_errors
 from dataset.importers.photos.sfm import SfmConfig
 from dataset.importers.photos.source import PhotosOptions, read_photos
 from dataset.importers.source import write_scenes
+from envelope.scene_record import Frame, Scene
 from envelope.scenes.scene import read_scene
 
 CAMERA_MAKE = "envelope-bench"
@@ -67,15 +68,12 @@ def strip_renders(scene_dir: str | Path, photos_dir: str | Path,
         No frame of those splits in the scene, or ``photos_dir`` exists.
     """
     scene = read_scene(scene_dir)
-    frames = [f for f in scene.frames if f.split in splits]
-    if not frames:
-        raise ValueError(f"{scene_dir} has no frames of splits {list(splits)} (it has "
-                         f"{sorted({f.split for f in scene.frames})})")
+    frames = _frames(scene, splits)
     photos_dir = Path(photos_dir)
     photos_dir.mkdir(parents=True)
     truth = {}
     for frame in frames:
-        name = Path(frame.file_path).stem + ".jpg"
+        name = _photo_name(frame)
         k = frame.intrinsics
         exif = Image.Exif()
         exif[ExifTags.Base.Make], exif[ExifTags.Base.Model] = CAMERA_MAKE, CAMERA_MODEL
@@ -86,6 +84,31 @@ def strip_renders(scene_dir: str | Path, photos_dir: str | Path,
                                       exif=exif)
         truth[name] = frame.world_from_camera
     return truth
+
+
+def stripped_poses(scene_dir: str | Path, splits: Sequence[str]) -> dict[str, np.ndarray]:
+    """The true poses :func:`strip_renders` returns for these splits, by photo name, without
+    copying anything (for photos stripped before).
+
+    Raises
+    ------
+    ValueError
+        No frame of those splits in the scene.
+    """
+    scene = read_scene(scene_dir)
+    return {_photo_name(f): f.world_from_camera for f in _frames(scene, splits)}
+
+
+def _frames(scene: Scene, splits: Sequence[str]) -> list[Frame]:
+    frames = [f for f in scene.frames if f.split in splits]
+    if not frames:
+        raise ValueError(f"{scene.root} has no frames of splits {list(splits)} (it has "
+                         f"{sorted({f.split for f in scene.frames})})")
+    return frames
+
+
+def _photo_name(frame: Frame) -> str:
+    return Path(frame.file_path).stem + ".jpg"
 
 
 def known_pair(truth: dict[str, np.ndarray]) -> KnownDistance:

@@ -88,6 +88,12 @@ def test_a_colmap_project_is_taken_as_it_is_and_read_as_stored(tmp_path, capsys)
     _check_metric(tmp_path / "out" / "survey", truth, ground_m=np.percentile(HEIGHTS, 1))
     meta = json.loads((tmp_path / "out" / "survey" / "transforms.json").read_text())
     assert meta["photos"]["input"] == "COLMAP model"
+    # Its poses are given: the record times reading, the metric frame, writing and the
+    # depth from its points alone.
+    for seconds in meta["photos"]["seconds"], meta["photos"]["cpu_seconds"]:
+        assert list(seconds) == ["reading", "metric_frame", "writing", "depth", "total"]
+        assert min(seconds.values()) >= 0
+        assert abs(seconds["total"] - sum(v for k, v in seconds.items() if k != "total")) <= 0.02
     sizes = {f["file_path"]: (f.get("w", meta["w"]), f.get("h", meta["h"]))
              for f in meta["frames"]}
     assert sizes["images/p0.jpg"] == (K.width, K.height)  # stored size, not turned
