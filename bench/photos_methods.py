@@ -18,7 +18,6 @@ WWR differences (the one scoring rule matches each scene's facades with the trut
 from __future__ import annotations
 
 import argparse
-import csv
 import subprocess
 import sys
 import time
@@ -37,6 +36,7 @@ from dataset.rendering.street_views import StreetConfig  # noqa: E402
 from dataset.scenes.scene_writer import GenerateConfig  # noqa: E402
 from envelope.protocols import EVAL_SPLIT, STREET_SPLIT, TRAIN_PROTOCOL  # noqa: E402
 from envelope.scenes.scene import read_scene  # noqa: E402
+from metrics.report.tables import read_csv_rows  # noqa: E402
 
 RECOVERED_SUFFIX = "-sfm"
 COLUMNS = ("building", "method", "protocol", "views", "WWR true cameras %",
@@ -76,11 +76,11 @@ def rows_of(compare: Path, benchmark: Path, buildings: list[str],
             protocol: str) -> list[list[str]]:
     """One row per building and method from the comparison's per-building and per-facade
     CSV files (``benchmark``: the scenes, for their view counts)."""
-    runs = {(r["scene"], r["method"]): r for r in _csv(compare / "per_building.csv")
-            if r["protocol"] == protocol}
+    buildings_csv = read_csv_rows((compare / "per_building.csv").read_text())
+    runs = {(r["scene"], r["method"]): r for r in buildings_csv if r["protocol"] == protocol}
     facades: dict[tuple[str, str, str], float] = {
         (r["scene"], r["method"], r["facade_id"]): float(r["wwr_est"])
-        for r in _csv(compare / "per_facade.csv")
+        for r in read_csv_rows((compare / "per_facade.csv").read_text())
         if r["protocol"] == protocol and r["kind"] == "matched"}
     methods = sorted({m for _, m in runs})
     rows = []
@@ -103,11 +103,6 @@ def rows_of(compare: Path, benchmark: Path, buildings: list[str],
                          *_iou(a["footprint_iou"], b["footprint_iou"]), str(len(shared)),
                          f"{np.median(diffs):.2f} / {diffs.max():.2f}" if len(diffs) else "-"])
     return rows
-
-
-def _csv(path: Path) -> list[dict[str, str]]:
-    with path.open() as f:
-        return list(csv.DictReader(line for line in f if not line.startswith("#")))
 
 
 def _pct(value: str) -> str:

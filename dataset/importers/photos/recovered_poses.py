@@ -84,9 +84,11 @@ def scenes_true_and_recovered(true_dir: str | Path, posed_dir: str | Path,
     true, posed = read_scene(true_dir), read_scene(posed_dir)
     by_stem = {Path(f.file_path).stem: f for f in true.frames}
     missing = [f.file_path for f in posed.frames if Path(f.file_path).stem not in by_stem]
-    if missing or len(posed.frames) < 2:
-        raise ValueError(f"{posed_dir}: {len(posed.frames)} posed photos; with no rendered view "
-                         f"in {true_dir}: {missing[:3]}")
+    if missing:
+        raise ValueError(f"{posed_dir}: photos with no rendered view in {true_dir}: "
+                         f"{', '.join(missing[:3])}")
+    if len(posed.frames) < 2:
+        raise ValueError(f"{posed_dir}: {len(posed.frames)} posed photos; the alignment needs 2")
     pairs = [(by_stem[Path(f.file_path).stem], f) for f in posed.frames]
     align = rigid_about_up(np.stack([p.world_from_camera[:3, 3] for _, p in pairs]),
                            np.stack([t.world_from_camera[:3, 3] for t, _ in pairs]))
