@@ -21,8 +21,10 @@ from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import torch
+from torch.nn import functional as F
 
 from envelope.classes import CLASS_NAMES, NUM_CLASSES
 from envelope.photo_io import read_photo_rgb
@@ -94,15 +96,43 @@ def calibrated_offsets(record: dict[str, Any], weights: str | Path) -> tuple[flo
 
 
 def predict_logits(model: UNet, rgb: np.ndarray, *, threads: int = 2) -> torch.Tensor:
-    """The network's class scores of every pixel: (H, W, 3) uint8 RGB -> (C, H, W) float32."""
+    """The network's class scores of every pixel: (H, W, 3) uint8 RGB -> (C, H, W) float32.
+
+    A network with a ``working_long_side_px`` sees the image scaled to that long side
+    (:func:`scale_to_long_side`, area averaging when shrinking) and its scores are scaled
+    back to (H, W) bilinearly."""
     previous = torch.get_num_threads()
     torch.set_num_threads(threads)
+    h, w = rgb.shape[:2]
+    working = scale_to_long_side(rgb, model.config.working_long_side_px)
     try:
         with torch.inference_mode():
-            x = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1)[None].float() / 255
-            return model(x.contiguous(memory_format=torch.channels_last))[0]
+            x = torch.from_numpy(np.ascontiguousarray(working)).permute(2, 0, 1)[None].float()
+            logits = model((x / 255).contiguous(memory_format=torch.channels_last))
+            if logits.shape[-2:] != (h, w):
+                logits = F.interpolate(logits, size=(h, w), mode="bilinear",
+                                       align_corners=False)
+            return logits[0]
     finally:
         torch.set_num_threads(previous)
+
+
+def scale_to_long_side(image: np.ndarray, long_side_px: int | None, *,
+                       labels: bool = False) -> np.ndarray:
+    """``image`` (H, W[, 3]) scaled so that its long side is ``long_side_px`` (the aspect
+    kept, sides rounded); unchanged for ``None`` or when it already has that size. RGB is
+    area-averaged when shrunk and bilinear when enlarged; ``labels`` (class ids) are taken
+    by nearest neighbour."""
+    if long_side_px is None:
+        return image
+    h, w = image.shape[:2]
+    factor = long_side_px / max(h, w)
+    size = (max(1, round(w * factor)), max(1, round(h * factor)))
+    if size == (w, h):
+        return image
+    interp = (cv2.INTER_NEAREST if labels else
+              cv2.INTER_AREA if factor < 1 else cv2.INTER_LINEAR)
+    return cv2.resize(np.ascontiguousarray(image), size, interpolation=interp)
 
 
 def predict_labels(model: UNet, rgb: np.ndarray, *, threads: int = 2,

@@ -40,9 +40,11 @@ from segment.real_sets.splits import LIST_DIR
 from segment.real_training import RealSource, real_sources
 from segment.segmenter import predict_labels
 from segment.training_data import (
+    PreloadedSource,
     TrainingScene,
     class_weights,
     load_training_scenes,
+    preload,
     sample_batch,
     split_by_building,
 )
@@ -63,7 +65,10 @@ class TrainConfig:
     between validations, on ``val_frames`` evenly spaced frames per validation scene.
     ``max_minutes``: a safety cap; a run it stops is marked ``cut_short``.
     ``real_share``: the share of each batch drawn from real photos when real sets are
-    given; ``real_val_photos``: validation photos per real set.
+    given; ``real_val_photos``: validation photos per real set. With a network that has a
+    ``working_long_side_px``, every training frame is read once and kept at that scale
+    (:func:`segment.training_data.preload`), ``render_frames`` evenly spaced frames of
+    each render building (0: all).
     """
 
     steps: int = 6000
@@ -78,6 +83,7 @@ class TrainConfig:
     max_minutes: float = 45.0
     real_share: float = 0.5
     real_val_photos: int = 24
+    render_frames: int = 0
     network: UNetConfig = field(default_factory=lambda: UNetConfig(base_channels=8, levels=6))
     augment: AugmentConfig = field(default_factory=AugmentConfig)
 
@@ -86,6 +92,8 @@ class TrainConfig:
             raise ValueError("steps, batch, threads, validate_every and val_frames must be >= 1")
         if self.val_every < 0 or self.learning_rate <= 0 or self.max_minutes <= 0:
             raise ValueError("val_every must be >= 0, learning_rate and max_minutes > 0")
+        if self.render_frames < 0:
+            raise ValueError("render_frames must be >= 0 (0: every frame)")
         if not 0 <= self.real_share <= 1 or self.real_val_photos < 1:
             raise ValueError("real_share must be in [0, 1] and real_val_photos >= 1")
 
@@ -132,6 +140,10 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
             libraries=("torch", "numpy", "opencv-contrib-python-headless"))
         rng = np.random.default_rng(config.seed)
         torch.manual_seed(config.seed)
+        long_side = config.network.working_long_side_px
+        if long_side is not None:
+            train = preload(train, long_side, config.render_frames, progress)
+            real_train = preload(real_train, long_side, 0, progress)
         weights = class_weights([*train, *real_train], rng)
         model = UNet(config.network).to(memory_format=torch.channels_last)
         best, history, steps_run = _optimise(model, (train, real_train), (val, real_val),
@@ -151,7 +163,10 @@ def train_segmenter(folders: Sequence[Path], out: Path, config: TrainConfig = Tr
         torch.set_num_threads(previous_threads)
 
 
-def _optimise(model: UNet, train: tuple[list[TrainingScene], list[RealSource]],
+Source = TrainingScene | RealSource | PreloadedSource
+
+
+def _optimise(model: UNet, train: tuple[list[Source], list[Source]],
               val: tuple[list[TrainingScene], list[RealSource]], weights: np.ndarray,
               config: TrainConfig, rng: np.random.Generator, start: float,
               progress: bool) -> tuple[_Best, list[dict[str, float]], int]:
@@ -207,7 +222,7 @@ def _optimise(model: UNet, train: tuple[list[TrainingScene], list[RealSource]],
     return best, history, step
 
 
-def _mixed_batch(renders: list[TrainingScene], real: list[RealSource], n_renders: int,
+def _mixed_batch(renders: list[Source], real: list[Source], n_renders: int,
                  n_real: int, config: TrainConfig, rng: np.random.Generator
                  ) -> tuple[torch.Tensor, torch.Tensor]:
     """``n_renders`` render crops then ``n_real`` real-photo crops, one batch."""
@@ -253,8 +268,7 @@ def training_sets(real: Mapping[str, Path]) -> dict[str, dict[str, str]]:
     return {"renders": dict(RENDERS_SOURCE), **{n: dict(SOURCES[n]) for n in sorted(real)}}
 
 
-def _record(config: TrainConfig, train: Sequence[TrainingScene | RealSource],
-            val: Sequence[TrainingScene | RealSource],
+def _record(config: TrainConfig, train: Sequence[Source], val: Sequence[Source],
             weights: np.ndarray, best: _Best, history: list[dict[str, float]],
             steps_run: int, times: dict[str, float]) -> dict[str, Any]:
     return {
@@ -317,6 +331,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--real-share", type=float, default=d.real_share,
                         help=f"share of each batch from real photos when real sets are given "
                         f"(default {d.real_share})")
+    n = d.network
+    parser.add_argument("--base-channels", type=int, default=n.base_channels,
+                        help=f"U-Net channels at its first scale (default {n.base_channels})")
+    parser.add_argument("--levels", type=int, default=n.levels,
+                        help=f"U-Net scales (default {n.levels})")
+    parser.add_argument("--stem-stride", type=int, choices=(1, 2), default=n.stem_stride,
+                        help="2: a strided stem halves the resolution first, the logits are "
+                        f"upsampled (default {n.stem_stride})")
+    parser.add_argument("--working-px", type=int, default=n.working_long_side_px,
+                        help="scale every image to this long side, in training and when "
+                        "segmenting (default: each image at its own size)")
+    parser.add_argument("--render-frames", type=int, default=d.render_frames,
+                        help="with --working-px: frames read per render building, evenly "
+                        f"spaced (default {d.render_frames}: all)")
+    parser.add_argument("--scale", type=float, nargs=2, metavar=("MIN", "MAX"),
+                        help="range of the crops' random zoom (default "
+                        f"{d.augment.scale[0]:g} {d.augment.scale[1]:g})")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
@@ -327,11 +358,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         check_output_folder(args.out.parent, "--out")
         real = {n: getattr(args, n) for n in SET_NAMES if getattr(args, n) is not None}
         augment = replace(REAL_PHOTO_AUGMENT if real else AugmentConfig(), crop_px=args.crop)
+        if args.scale is not None:
+            augment = replace(augment, scale=tuple(args.scale))
+        network = UNetConfig(base_channels=args.base_channels, levels=args.levels,
+                             stem_stride=args.stem_stride,
+                             working_long_side_px=args.working_px)
         config = TrainConfig(
             steps=args.steps, batch=args.batch, learning_rate=args.learning_rate,
             seed=args.seed, threads=args.threads, val_every=args.val_every,
             validate_every=args.validate_every, max_minutes=args.max_minutes,
-            real_share=args.real_share, augment=augment)
+            real_share=args.real_share, render_frames=args.render_frames, network=network,
+            augment=augment)
         record = train_segmenter(args.data, args.out, config, real=real or None,
                                  progress=not args.quiet)
         print(f"wrote {args.out} ({len(record['trained_on'])} training scenes, "

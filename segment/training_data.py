@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 import torch
+from tqdm import tqdm
 
 from dataset.presets import PRESETS, preset_recipes
 from envelope.classes import NUM_CLASSES
@@ -25,6 +26,8 @@ from envelope.scenes.images import read_rgb
 from envelope.scenes.scene import find_scene_folders, read_scene
 from envelope.scenes.scene_validation import read_frame_labels
 from segment.augment import IGNORE_LABEL, AugmentConfig, augment_frame
+from segment.evaluate import evenly_spaced
+from segment.segmenter import scale_to_long_side
 
 TRAINING_PRESET = "segtrain"
 EVALUATED_PRESETS: tuple[str, ...] = tuple(p for p in PRESETS if p != TRAINING_PRESET)
@@ -119,6 +122,49 @@ def sample_batch(scenes: Sequence[Any], batch: int, config: AugmentConfig,
     return x.contiguous(memory_format=torch.channels_last), torch.from_numpy(np.stack(ys))
 
 
+@dataclass(frozen=True)
+class PreloadedSource:
+    """The frames of a training scene or real-photo source, read once and kept in memory
+    at a network's working scale: ``frames`` are indices into ``rgbs`` and ``labels_``;
+    ``name`` and ``record`` are the source's."""
+
+    name: str
+    frames: tuple[int, ...]
+    record: dict[str, Any]
+    rgbs: tuple[np.ndarray, ...]
+    label_maps: tuple[np.ndarray, ...]
+
+    def rgb_and_labels(self, frame: int) -> tuple[np.ndarray, np.ndarray]:
+        """(h, w, 3) uint8 RGB and (h, w) uint8 class ids at the working scale."""
+        return self.rgbs[frame], self.label_maps[frame]
+
+    def labels(self, frame: int) -> np.ndarray:
+        """(h, w) uint8 class ids at the working scale."""
+        return self.label_maps[frame]
+
+
+def preload(sources: Sequence[Any], long_side_px: int | None, frames_per_source: int = 0,
+            progress: bool = True) -> list[PreloadedSource]:
+    """Each of ``sources`` (training scenes or real-photo sources) read once, every frame
+    scaled to ``long_side_px`` (``None``: as it is;
+    :func:`segment.segmenter.scale_to_long_side`), at most ``frames_per_source`` evenly
+    spaced frames of each (0: all), so that a training step decodes nothing."""
+    out = []
+    for source in tqdm(sources, desc="read training frames", unit="source",
+                       disable=not progress):
+        picked = (evenly_spaced(source.frames, frames_per_source) if frames_per_source
+                  else source.frames)
+        rgbs, label_maps = [], []
+        for frame in picked:
+            rgb, labels = source.rgb_and_labels(frame)
+            rgbs.append(scale_to_long_side(rgb, long_side_px))
+            label_maps.append(scale_to_long_side(labels, long_side_px, labels=True))
+        out.append(PreloadedSource(source.name, tuple(range(len(rgbs))),
+                                   {**source.record, "frames_read": len(rgbs)},
+                                   tuple(rgbs), tuple(label_maps)))
+    return out
+
+
 def _training_scene(scene: Scene) -> TrainingScene:
     generator = scene.extra.get("generator") or {}
     inputs = (generator.get("provenance") or {}).get("inputs") or {}
@@ -141,5 +187,5 @@ def _training_scene(scene: Scene) -> TrainingScene:
     return TrainingScene(scene, frames, record)
 
 
-__all__ = ["IGNORE_LABEL", "TrainingScene", "class_weights", "load_training_scenes",
-           "sample_batch", "split_by_building"]
+__all__ = ["IGNORE_LABEL", "PreloadedSource", "TrainingScene", "class_weights",
+           "load_training_scenes", "preload", "sample_batch", "split_by_building"]

@@ -34,3 +34,19 @@ def test_bad_inputs_and_configs_are_refused():
         UNetConfig(num_classes=1)
     with pytest.raises(ValueError, match="levels"):
         UNetConfig(levels=0)
+
+
+@pytest.mark.parametrize("size", [(1, 1), (37, 53), (64, 64)])
+def test_a_strided_stem_still_gives_logits_of_the_input_size(size):
+    model = UNet(UNetConfig(base_channels=4, levels=3, stem_stride=2)).eval()
+    with torch.no_grad():
+        out = model(torch.rand(1, 3, *size))
+    assert out.shape == (1, NUM_CLASSES, *size)
+    assert torch.isfinite(out).all()
+
+
+def test_stem_and_working_scale_are_checked():
+    with pytest.raises(ValueError, match="stem_stride must be 1 or 2"):
+        UNetConfig(stem_stride=4)
+    with pytest.raises(ValueError, match="working_long_side_px"):
+        UNetConfig(working_long_side_px=8)

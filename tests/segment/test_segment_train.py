@@ -68,7 +68,8 @@ def test_a_few_steps_write_weights_with_their_record(trained, clean_scene):
     assert [s["scene"] for s in record["trained_on"]] == [clean_scene.name]
     assert record["trained_on"][0]["preset"] is None and record["validated_on"] == []
     assert list(record["training_sets"]) == ["renders"]
-    assert record["config"]["network"] == {"base_channels": 4, "levels": 3, "num_classes": 6}
+    assert record["config"]["network"] == {"base_channels": 4, "levels": 3, "num_classes": 6,
+                                           "stem_stride": 1, "working_long_side_px": None}
     assert len(record["class_weights"]) == len(CLASS_NAMES)
     assert record["provenance"]["config"]["seed"] == 0
     # The times keep milliseconds: a fast machine's 12 ms of CPU are 0.012 s, not 0.0. The wall
@@ -216,3 +217,21 @@ def test_the_cli_explains_itself_and_refuses_bad_options(clean_scene, tmp_path, 
     assert main(["--data", str(tmp_path / "none"), "--out", str(tmp_path / "w.pt")]) == 2
     assert "does not exist" in capsys.readouterr().err
     assert not (tmp_path / "w.pt").exists()
+
+
+@pytest.mark.slow
+def test_a_strided_network_at_a_working_scale_trains_and_segments_photos_of_any_size(
+        clean_scene, tmp_path):
+    out = tmp_path / "wide.pt"
+    assert main(["--data", str(clean_scene), "--out", str(out), "--steps", "2", "--batch", "2",
+                 "--crop", "32", "--threads", "1", "--val-every", "0", "--base-channels", "4",
+                 "--levels", "3", "--stem-stride", "2", "--working-px", "48",
+                 "--render-frames", "2", "--scale", "0.8", "1.2", "--quiet"]) == 0
+    record = json.loads(out.with_suffix(".json").read_text())
+    assert record["config"]["network"]["working_long_side_px"] == 48
+    assert record["config"]["augment"]["scale"] == [0.8, 1.2]
+    assert [s["frames_read"] for s in record["trained_on"]] == [2]
+    segment = network_segmenter(out, threads=1).segment
+    for shape in ((31, 77, 3), (200, 90, 3)):
+        labels = segment(np.random.default_rng(0).integers(0, 256, shape).astype(np.uint8))
+        assert labels.shape == shape[:2] and labels.max() < len(CLASS_NAMES)
