@@ -12,7 +12,9 @@ the exact window pixels) gives the area and IoU of every offset at once.
 ``python -m segment.calibrate --data DIR [DIR ...]`` reads the validation buildings that
 the weights' record names (never evaluated, never trained on), writes the offsets into
 the weights file (``record["calibration"]``) and prints the window area ratio and IoU
-before and after.
+before and after. Weights picked on real validation photos (trained with real sets) are
+calibrated on those same photos instead (``--labelmefacade DIR``, ``--cmp DIR``); pixels
+their labels do not count are left out.
 """
 
 from __future__ import annotations
@@ -29,8 +31,11 @@ from tqdm import tqdm
 
 from envelope.classes import NUM_CLASSES, SemanticClass
 from envelope.cli_errors import add_debug_flag, exit_cli, run_cli
+from segment.augment import IGNORE_LABEL
 from segment.evaluate import evenly_spaced
 from segment.network import UNet
+from segment.real_sets import SET_NAMES
+from segment.real_training import RealSource, real_sources
 from segment.segmenter import predict_logits
 from segment.training_data import TrainingScene, load_training_scenes
 from segment.weights import RENDER_WEIGHTS, load_network, save_weights
@@ -69,17 +74,21 @@ def window_margin(model: UNet, rgb: np.ndarray, threads: int) -> np.ndarray:
     return (logits[w] - others.max(0).values).numpy()
 
 
-def margin_histograms(model: UNet, scenes: Sequence[TrainingScene], frames: int,
+Validation = TrainingScene | RealSource
+
+
+def margin_histograms(model: UNet, scenes: Sequence[Validation], frames: int,
                       threads: int, progress: bool = False) -> tuple[np.ndarray, np.ndarray, int]:
-    """(all pixels, exact window pixels) histograms of the margin over ``MARGIN_EDGES``, and
-    the number of frames read (``frames`` evenly spaced ones per scene)."""
+    """(counted pixels, exact window pixels) histograms of the margin over ``MARGIN_EDGES``,
+    and the number of frames read (``frames`` evenly spaced ones per scene or set of photos);
+    a pixel labelled :data:`IGNORE_LABEL` is not counted."""
     every = np.zeros(len(MARGIN_EDGES) - 1, np.int64)
     window = np.zeros_like(every)
     pairs = [(s, f) for s in scenes for f in evenly_spaced(s.frames, frames)]
     for scene, frame in tqdm(pairs, desc="calibrate", unit="frame", disable=not progress):
         rgb, exact = scene.rgb_and_labels(frame)
         margin = np.clip(window_margin(model, rgb, threads), MARGIN_EDGES[0], MARGIN_EDGES[-1])
-        every += np.histogram(margin, MARGIN_EDGES)[0]
+        every += np.histogram(margin[exact != IGNORE_LABEL], MARGIN_EDGES)[0]
         window += np.histogram(margin[exact == SemanticClass.WINDOW], MARGIN_EDGES)[0]
     return every, window, len(pairs)
 
@@ -104,7 +113,7 @@ def unbiased_offset(every: np.ndarray, window: np.ndarray) -> float:
     return float(-MARGIN_EDGES[best]) + 0.0  # + 0.0: 0.0 rather than -0.0 at the middle edge
 
 
-def calibrate_window(model: UNet, scenes: Sequence[TrainingScene], frames: int = 24,
+def calibrate_window(model: UNet, scenes: Sequence[Validation], frames: int = 24,
                      threads: int = 2, progress: bool = False) -> WindowCalibration:
     """The window offset that makes the window area unbiased on ``scenes``."""
     every, window, read = margin_histograms(model, scenes, frames, threads, progress)
@@ -115,22 +124,25 @@ def calibrate_window(model: UNet, scenes: Sequence[TrainingScene], frames: int =
                              tuple(sorted(f"{s.record['folder']}/{s.name}" for s in scenes)))
 
 
-def validation_scenes(record: dict[str, Any], folders: Sequence[Path]) -> list[TrainingScene]:
-    """The buildings ``record["validated_on"]`` names (by name and resolution), read from
-    ``folders``; each carries its entry of the record, so a calibration names them as the
-    training did, wherever they are read from.
+def validation_scenes(record: dict[str, Any], folders: Sequence[Path],
+                      real: dict[str, Path] | None = None) -> list[Validation]:
+    """What ``record["validated_on"]`` names: the validation buildings (by name and
+    resolution) read from ``folders``, each carrying its entry of the record, so a
+    calibration names them as the training did wherever they are read from; or, for weights
+    picked on real photos, the same validation photos read from ``real`` (set name ->
+    folder, :mod:`segment.real_training`).
 
     Raises
     ------
     ValueError
         If the record names no validation building or none of them is in ``folders``, or
-        the weights were picked on real photos (:mod:`segment.real_training`).
+        the weights were picked on real photos whose sets ``real`` lacks or whose copy
+        holds other validation photos than the record names.
     """
     validated = record.get("validated_on") or []
-    if any("set" in v for v in validated):
-        raise ValueError("these weights were picked on real validation photos (trained with "
-                         "--labelmefacade/--cmp): an offset chosen on the render validation "
-                         "buildings would be chosen off their domain; they are not calibrated")
+    photos = [v for v in validated if "set" in v]
+    if photos:
+        return _validation_photos(photos, real or {})
     wanted = {(v["scene"], v.get("resolution")): v for v in validated}
     if not wanted:
         raise ValueError("these weights record no validation buildings to calibrate on; "
@@ -147,19 +159,43 @@ def validation_scenes(record: dict[str, Any], folders: Sequence[Path]) -> list[T
     return found
 
 
+def _validation_photos(validated: list[dict[str, Any]], real: dict[str, Path]
+                       ) -> list[RealSource]:
+    """The real validation photos of ``validated`` (entries of a weights record), checked
+    to be the very photos the record names."""
+    missing = [v["set"] for v in validated if v["set"] not in real]
+    if missing:
+        raise ValueError(f"these weights were picked on real validation photos; calibrate "
+                         f"them on the same photos: give --{missing[0]} DIR (a copy of "
+                         f"that set, docs/segment.md)")
+    roots = {v["set"]: real[v["set"]] for v in validated}
+    _, sources = real_sources(roots, val_photos=max(v["photos"] for v in validated))
+    read = {s.set_name: [p.name for p in s.frames] for s in sources}
+    for entry in validated:
+        if read.get(entry["set"]) != entry["names"]:
+            raise ValueError(f"{roots[entry['set']]} does not hold the validation photos the "
+                             f"weights' record names for {entry['set']}; give the copy they "
+                             f"were trained with")
+    return sources
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
         prog="python -m segment.calibrate",
         description="Choose the window logit offset that makes a segmenter's window area "
-        "unbiased on its validation buildings (never evaluated) and write it into the "
-        "weights file.",
+        "unbiased on its validation buildings (never evaluated), or on its validation photos "
+        "when it was picked on real photos, and write it into the weights file.",
         epilog="example: python -m segment.calibrate --data data/segtrain-128 --data "
         "data/segtrain-512. Details: docs/segment.md.")
-    parser.add_argument("--data", type=Path, action="append", required=True,
+    parser.add_argument("--data", type=Path, action="append", default=[],
                         help="a folder holding the validation buildings (repeat for several)")
+    for name in SET_NAMES:
+        parser.add_argument(f"--{name}", type=Path,
+                            help=f"a copy of the real set {name}, for weights picked on its "
+                            f"validation photos")
     parser.add_argument("--weights", type=Path, default=RENDER_WEIGHTS,
                         help="weights file to calibrate (default: the committed render-trained "
-                        "weights; weights picked on real photos are refused)")
+                        "weights)")
     parser.add_argument("--out", type=Path, default=None,
                         help="where to write the calibrated weights (default: --weights)")
     parser.add_argument("--frames", type=int, default=24,
@@ -172,14 +208,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.frames < 1 or args.threads < 1:
             raise ValueError("--frames and --threads must be >= 1")
         model, record = load_network(args.weights)
-        scenes = validation_scenes(record, args.data)
+        real = {n: getattr(args, n) for n in SET_NAMES if getattr(args, n) is not None}
+        scenes = validation_scenes(record, args.data, real)
         result = calibrate_window(model, scenes, args.frames, args.threads, progress=True)
         record = {**record, "calibration": {**asdict(result),
                                             "logit_offsets": result.logit_offsets()}}
         out = args.out or args.weights
         save_weights(out, model, record)
         print(f"window offset {result.window_offset:+.3f} on {result.frames} frames of "
-              f"{len(scenes)} validation buildings: window area ratio "
+              f"{len(scenes)} validation sources: window area ratio "
               f"{result.area_ratio_before:.3f} -> {result.area_ratio_after:.3f}, window IoU "
               f"{result.iou_before:.3f} -> {result.iou_after:.3f}; wrote {out}")
         return 0

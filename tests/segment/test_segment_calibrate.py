@@ -137,3 +137,19 @@ def test_the_committed_weights_are_calibrated_on_their_validation_buildings():
     assert cal["iou_after"] >= cal["iou_before"] - 0.01
     offsets = calibrated_offsets(record, RENDER_WEIGHTS)
     assert offsets is not None and offsets[WINDOW] == cal["window_offset"]
+
+
+def test_pixels_the_labels_do_not_count_are_left_out_of_the_histograms():
+    from types import SimpleNamespace
+
+    from segment.augment import IGNORE_LABEL
+    from segment.calibrate import margin_histograms
+
+    model = _model()
+    rgb = np.random.default_rng(0).integers(0, 256, (12, 10, 3)).astype(np.uint8)
+    labels = np.full((12, 10), SemanticClass.WALL, np.uint8)
+    labels[2:6, 2:6] = WINDOW  # 16 window pixels
+    labels[:, 8:] = IGNORE_LABEL  # 24 pixels not counted
+    source = SimpleNamespace(frames=("a",), rgb_and_labels=lambda frame: (rgb, labels))
+    every, window, read = margin_histograms(model, [source], frames=4, threads=1)
+    assert read == 1 and every.sum() == 120 - 24 and window.sum() == 16

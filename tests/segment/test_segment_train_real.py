@@ -13,6 +13,7 @@ from real_set_folders import LMF_PHOTOS, write_cmp, write_labelmefacade
 
 from envelope.classes import SemanticClass
 from segment.augment import IGNORE_LABEL, REAL_PHOTO_AUGMENT, AugmentConfig, augment_frame
+from segment.calibrate import main as calibrate_main
 from segment.calibrate import validation_scenes
 from segment.network import UNetConfig
 from segment.real_sets.splits import LIST_DIR
@@ -72,8 +73,22 @@ def test_a_few_steps_on_renders_and_real_photos(clean_scene, tmp_path):
     assert sets["labelmefacade"]["licence"].startswith("non-commercial research use only")
     assert all(s["licence"] and s["repository"] for s in sets.values())
     load_network(out)
-    with pytest.raises(ValueError, match="picked on real validation photos"):
+    with pytest.raises(ValueError, match="picked on real validation photos.*--labelmefacade"):
         validation_scenes(record, [clean_scene])  # not calibrated on renders
+    # Calibrated on the very validation photos that picked the weights, read from the sets.
+    sources = validation_scenes(record, [], roots)
+    assert [[p.name for p in s.frames] for s in sources] == [
+        v["names"] for v in record["validated_on"]]
+    assert calibrate_main(["--weights", str(out), "--out", str(tmp_path / "cal.pt"),
+                           "--labelmefacade", str(roots["labelmefacade"]),
+                           "--cmp", str(roots["cmp"]), "--threads", "1"]) == 0
+    calibration = json.loads((tmp_path / "cal.json").read_text())["calibration"]
+    assert calibration["frames"] == 2 and len(calibration["logit_offsets"]) == 6
+    # A copy holding other validation photos than the record names is refused.
+    other = {"labelmefacade": roots["labelmefacade"], "cmp": write_cmp(tmp_path / "cmp2")}
+    (other["cmp"] / "base" / "cmp_b0002.jpg").unlink()
+    with pytest.raises(ValueError, match="does not hold the validation photos"):
+        validation_scenes(record, [], other)
 
 
 @pytest.mark.slow
