@@ -47,9 +47,11 @@ REPORT_SPLITS = (PHOTO_TEST, PHOTO_VAL, PHOTO_TRAIN)
 
 
 def evaluate_set(photos: Sequence[RealPhoto], segmenter: Segmenter,
-                 max_photos: int | None = None) -> dict[str, list[PhotoResult]]:
+                 max_photos: int | None = None, splits: Sequence[str] = REPORT_SPLITS
+                 ) -> dict[str, list[PhotoResult]]:
     """Results per split (:data:`REPORT_SPLITS` order) of a set's photos; at most
-    ``max_photos`` evenly spaced photos per split (all for ``None``)."""
+    ``max_photos`` evenly spaced photos per split (all for ``None``); the photos of a split
+    not in ``splits`` are not read (an empty list)."""
     committed = committed_splits(photos[0].set_name) if photos else {}
     by_split: dict[str, list[RealPhoto]] = {s: [] for s in REPORT_SPLITS}
     for photo in photos:
@@ -58,7 +60,7 @@ def evaluate_set(photos: Sequence[RealPhoto], segmenter: Segmenter,
             by_split[split].append(photo)
     out = {}
     for split in REPORT_SPLITS:
-        chosen = evenly_spaced(by_split[split], max_photos)
+        chosen = evenly_spaced(by_split[split], max_photos) if split in splits else ()
         out[split] = [photo_result(p, split, segmenter)
                       for p in tqdm(chosen, desc=f"{photos[0].set_name} {split}",
                                     unit="photo")] if chosen else []
@@ -78,7 +80,8 @@ def report_markdown(results: dict[str, dict[str, list[PhotoResult]]], segmenter:
         "Written by:", "", "```bash", command, "```", "",
         f"{when}, code `{code}`, segmenter `{segmenter.name}` ({ident}); "
         f"{threads} torch thread(s), {wall_s:.0f} s wall, {cpu_s:.0f} s CPU. Each photo is "
-        f"segmented once at its own size; its split comes from the committed lists "
+        f"segmented once (at the network's working size if it has one, the answer scaled "
+        f"back to the photo's size); its split comes from the committed lists "
         f"(`segment/real_sets/splits/`); nothing is tuned on these photos. Definitions: "
         f"docs/segment.md, \"Real labelled facades\".", "",
         "| set | copy read (source, commit) | licence |", "|---|---|---|",
@@ -159,6 +162,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                         "WWR of the labels and of the prediction) to this CSV file")
     parser.add_argument("--max-photos", type=int, default=None,
                         help="evenly spaced photos per set and split (default: all)")
+    parser.add_argument("--splits", nargs="+", choices=REPORT_SPLITS, default=REPORT_SPLITS,
+                        help="the splits to read (default: all); e.g. `--splits val` to "
+                        "choose between segmenters without reading a test photo")
     parser.add_argument("--threads", type=int, default=2, help="torch threads (default: 2)")
     add_debug_flag(parser)
     args = parser.parse_args(argv)
@@ -173,7 +179,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         segmenter = resolve_segmenter(args.model, threads=args.threads)
         started = (datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"), code_version())
         start_wall, start_cpu = time.perf_counter(), time.process_time()
-        results = {name: evaluate_set(photos, segmenter, args.max_photos)
+        results = {name: evaluate_set(photos, segmenter, args.max_photos, args.splits)
                    for name, photos in sets.items()}
         seconds = (time.perf_counter() - start_wall, time.process_time() - start_cpu)
         command = "python -m segment.evaluate_real " + shlex.join(

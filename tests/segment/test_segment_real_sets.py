@@ -159,6 +159,10 @@ def test_evaluate_set_takes_the_committed_splits(tmp_path):
     expected = {s: [n for n, _, split in LMF_PHOTOS if split == s] for s in SPLITS}
     assert {s: [r.name for r in rows] for s, rows in results.items()} == expected
     assert split_scores(results["test"]).window_recall == 0.0
+    # Choosing between segmenters reads the validation photos alone.
+    only_val = evaluate_set(photos, everything_wall, splits=("val",))
+    assert {s: [r.name for r in rows] for s, rows in only_val.items()} == {
+        "test": [], "val": expected["val"], "train": []}
 
 
 def test_evaluate_real_writes_the_report(tmp_path, capsys):
