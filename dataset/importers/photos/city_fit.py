@@ -1,0 +1,227 @@
+"""Scale, north and place from a city model (``--city-model``): the photos' levelled sparse
+points fitted to the model's surfaces by a similarity about the vertical (scale, heading,
+3D shift), with no initial guess (docs/importing.md, section 9).
+
+1. *Search* (:mod:`dataset.importers.photos.city_search`): headings and scales on grids,
+   the horizontal shift by correlating the points' ground projection with the model's wall
+   lines; the best :attr:`~dataset.importers.photos.city_search.SearchConfig.candidates`
+   distinct peaks are kept.
+2. *Refine* each (:mod:`dataset.importers.photos.city_icp`): trimmed point-to-plane ICP with
+   scale, down to the inlier distance
+   :data:`~dataset.importers.photos.city_icp.TRIMS_M` ``[-1]``; the fit that brings the most
+   points within it of a surface wins.
+3. *Refuse* (one line, nothing written) a fit that is bad or ambiguous
+   (:class:`CityFitConfig`, :func:`check_fit`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dataset.importers.photos.city_icp import (
+    TRIMS_M,
+    PlacedSimilarity,
+    Residuals,
+    refine,
+    surface_samples,
+)
+from dataset.importers.photos.city_search import (
+    SearchConfig,
+    coarse_candidates,
+    distinct,
+    scale_guess,
+)
+from dataset.importers.photos.city_target import CityTarget
+
+FALLBACK = "give --known-distance or --known-height instead"
+POINT_SEED = 0
+
+
+@dataclass(frozen=True)
+class CityFitConfig:
+    """The fit's settings and its refusal rules.
+
+    ``max_points``: the sparse points used at most (drawn with a fixed seed);
+    ``min_inliers`` and ``min_inlier_share``: the least count and share of them within the
+    inlier distance of a model surface after the fit (fewer: a bad fit, refused);
+    ``ambiguity_ratio``: a second, distinct fit (another heading, scale or place) bringing
+    at least this share of the best one's points within the best one's own yardstick
+    (:meth:`CityFit.judge_m`) makes the fit ambiguous (refused).
+    docs/decisions.md (2026-11-29, "Scale from a city model") says where the numbers come
+    from."""
+
+    search: SearchConfig = SearchConfig()
+    max_points: int = 20000
+    min_inliers: int = 200
+    min_inlier_share: float = 0.2
+    ambiguity_ratio: float = 0.8
+    judge_factor: float = 3.0
+    min_judge_m: float = 0.05
+
+    def __post_init__(self) -> None:
+        if not (self.max_points >= self.min_inliers >= 10 and 0 < self.min_inlier_share < 1
+                and 0 < self.ambiguity_ratio < 1):
+            raise ValueError(f"city fit config out of range: {self}")
+
+
+@dataclass(frozen=True)
+class Solution:
+    """One refined candidate: its similarity and residuals (over the points used)."""
+
+    similarity: PlacedSimilarity
+    residuals: Residuals
+
+    @property
+    def inliers(self) -> int:
+        """Points within the inlier distance of a model surface that faces their camera."""
+        return int(self.residuals.inlier.sum())
+
+    def within(self, distance_m: float) -> int:
+        """Inliers within ``distance_m`` of their surface."""
+        res = self.residuals
+        return int((res.inlier & (res.distance_m <= distance_m)).sum())
+
+
+@dataclass(frozen=True)
+class CityFit:
+    """The best fit, the best distinct other one (``None``: every candidate came to the best
+    one), the points used and the yardstick ``judge_m`` the two are compared by: the best
+    fit's median inlier residual times ``judge_factor``, within ``min_judge_m`` and the
+    inlier distance (a fit as tight as the best one explains the points as well)."""
+
+    best: Solution
+    runner_up: Solution | None
+    points_used: int
+    judge_m: float
+
+    @property
+    def runner_up_ratio(self) -> float:
+        """The runner-up's points within ``judge_m`` over the best one's (0 without a
+        runner-up)."""
+        if self.runner_up is None:
+            return 0.0
+        return self.runner_up.within(self.judge_m) / max(self.best.within(self.judge_m), 1)
+
+    def record(self, target: CityTarget, config: CityFitConfig) -> dict:
+        """The ``city_model`` entry of the scene's ``photos`` record."""
+        res = self.best.residuals
+        inlier = res.distance_m[res.inlier]
+        out = {**target.record(),
+               "points_used": self.points_used, "inliers": self.best.inliers,
+               "inlier_share": round(self.best.inliers / self.points_used, 4),
+               "inlier_distance_m": res.trim_m,
+               "residual_median_m": round(float(np.median(inlier)), 4),
+               "residual_rms_m": round(float(np.sqrt(np.mean(inlier ** 2))), 4),
+               "scale_factor": self.best.similarity.scale,
+               "heading_deg": round(float(np.degrees(self.best.similarity.heading_rad)), 4),
+               "judge_m": round(self.judge_m, 4),
+               "runner_up_ratio": round(self.runner_up_ratio, 4),
+               "rules": {"min_inliers": config.min_inliers,
+                         "min_inlier_share": config.min_inlier_share,
+                         "ambiguity_ratio": config.ambiguity_ratio}}
+        if self.runner_up is not None:
+            other = self.runner_up.similarity
+            out["runner_up"] = {"inliers": self.runner_up.inliers,
+                                "within_judge": self.runner_up.within(self.judge_m),
+                                "heading_deg": round(float(np.degrees(other.heading_rad)), 2),
+                                "scale_factor": other.scale}
+        return out
+
+
+def fit_city_model(points: np.ndarray, cameras: np.ndarray, ground_z: float, top_z: float,
+                   target: CityTarget, config: CityFitConfig = CityFitConfig()) -> CityFit:
+    """The similarity taking (N, 3) levelled sparse points (z up, any scale; their ground
+    and top at heights ``ground_z`` and ``top_z``), seen from (K, 3) levelled camera
+    centres, onto ``target``'s surfaces (module docstring).
+
+    Raises
+    ------
+    ValueError
+        Too few points, a bad fit or an ambiguous one (:func:`check_fit`), with the rule.
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) < config.min_inliers:
+        raise ValueError(f"--city-model: structure from motion gave {len(points)} sparse "
+                         f"points; the fit needs at least {config.min_inliers} on the model's "
+                         f"surfaces: {FALLBACK}")
+    if len(points) > config.max_points:
+        rng = np.random.default_rng(POINT_SEED)
+        points = points[np.sort(rng.choice(len(points), config.max_points, replace=False))]
+    samples = surface_samples(target.triangles_m)
+    ground = np.array([*np.median(points[:, :2], axis=0), ground_z])
+    middle = np.median(points, axis=0)
+    coarse = [c.similarity for c in coarse_candidates(
+        points, ground_z, top_z, samples, target.building_height_m, config.search)]
+    guess = scale_guess(ground_z, top_z, target.building_height_m)
+    low, high = (guess * np.exp(sign * config.search.scale_step) * config.search.scale_range
+                 ** sign for sign in (-1, 1))
+    solutions = []
+    for start in coarse + quarter_turns(coarse[0], middle):
+        similarity, res = refine(points, cameras, ground, samples, start)
+        if low <= similarity.scale <= high:  # else it ran off the scales searched
+            solutions.append(Solution(similarity, res))
+    if not solutions:
+        raise ValueError(f"--city-model: every fit ran off the scales searched ({low:.3g} to "
+                         f"{high:.3g}, from the building's height): the photos may not show "
+                         f"its foot and top, or show another place: {FALLBACK}")
+    solutions.sort(key=lambda s: -s.inliers)
+    best = solutions[0]
+    others = [s for s in solutions[1:]
+              if distinct(best.similarity, s.similarity, middle, config.search)]
+    residual = float(np.median(best.residuals.distance_m[best.residuals.inlier])) \
+        if best.inliers else TRIMS_M[-1]
+    judge = float(np.clip(config.judge_factor * residual, config.min_judge_m, TRIMS_M[-1]))
+    others.sort(key=lambda s: -s.within(judge))
+    fit = CityFit(best, others[0] if others else None, len(points), judge)
+    check_fit(fit, target, config)
+    return fit
+
+
+def quarter_turns(start: PlacedSimilarity, middle: np.ndarray) -> list[PlacedSimilarity]:
+    """``start`` turned a quarter, a half and three quarters about the vertical through
+    where it takes the (3,) levelled point ``middle``: a building's symmetric alternatives,
+    always tried, so that a fit they match as well is found ambiguous."""
+    land = start.apply(middle[None])[0]
+    out = []
+    for k in (1, 2, 3):
+        turned = PlacedSimilarity(start.scale, start.heading_rad + k * np.pi / 2,
+                                  np.zeros(3))
+        out.append(PlacedSimilarity(start.scale, turned.heading_rad,
+                                    land - turned.apply(middle[None])[0]))
+    return out
+
+
+def check_fit(fit: CityFit, target: CityTarget, config: CityFitConfig) -> None:
+    """Refuse a bad fit (fewer than ``min_inliers`` or ``min_inlier_share`` of the points
+    near a surface) or an ambiguous one (a distinct runner-up at ``ambiguity_ratio`` of the
+    best's inliers or more).
+
+    Raises
+    ------
+    ValueError
+        One line: what was found, the rule, and what to do.
+    """
+    share = fit.best.inliers / fit.points_used
+    trim = TRIMS_M[-1]
+    where = f"building {target.building} and its {len(target.neighbours)} neighbours"
+    if fit.best.inliers < config.min_inliers or share < config.min_inlier_share:
+        raise ValueError(
+            f"--city-model: after the best fit only {fit.best.inliers} of {fit.points_used} "
+            f"sparse points ({share:.0%}) lie within {trim:g} m of a surface of {where}; at "
+            f"least {config.min_inliers} and {config.min_inlier_share:.0%} must: the photos "
+            f"show another place or another building (check --city-building), or the model "
+            f"too little of what they show: {FALLBACK}")
+    if fit.runner_up is not None and fit.runner_up_ratio >= config.ambiguity_ratio:
+        a, b = fit.best.similarity, fit.runner_up.similarity
+        raise ValueError(
+            f"--city-model: two fits explain the photos alike (heading "
+            f"{np.degrees(a.heading_rad) % 360:.0f} and {np.degrees(b.heading_rad) % 360:.0f} "
+            f"degrees, scale {a.scale:.4g} and {b.scale:.4g}: "
+            f"{fit.best.within(fit.judge_m)} and {fit.runner_up.within(fit.judge_m)} points "
+            f"within {fit.judge_m:.2g} m of a surface, ratio "
+            f"{fit.runner_up_ratio:.2f}, refused from {config.ambiguity_ratio:g}): the "
+            f"photos see too little that is not repeated or symmetric (one wall, a square "
+            f"building from all round, a row of like houses); photograph the neighbours or "
+            f"corners too, or {FALLBACK}")
