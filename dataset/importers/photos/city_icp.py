@@ -31,7 +31,7 @@ TRIMS_M = (4.0, 2.0, 1.0, 0.5)
 """The trim distances (metres) of the refinement, in turn; the last is the inlier distance:
 a point within it of a model surface is on that surface. 0.5 m: a LoD2 wall stands within
 about that of the facade it models (its sills, reveals and balconies left out)."""
-STEPS_PER_TRIM = 12
+STEPS_PER_TRIM = 10
 """Gauss-Newton steps at most per trim distance (it stops sooner when a step changes no
 point's place by a millimetre)."""
 GROUND_WEIGHT = 0.02

@@ -26,6 +26,10 @@ from dataset.importers.photos.city_icp import PlacedSimilarity, SurfaceSamples
 
 CLIP_PERCENTILES = (5.0, 95.0)
 """Points outside the box between these percentiles take no part in the coarse search."""
+MAX_SPREAD = 3.0
+"""Scales at which those points' box would be wider than this many times the model walls'
+box are not tried: the model is assumed to hold what the photos see (the building and the
+neighbours round it), so their points spread no wider than it, with a margin."""
 
 
 @dataclass(frozen=True)
@@ -42,7 +46,7 @@ class SearchConfig:
     heading_step_deg: float = 6.0
     scale_step: float = 0.12
     scale_range: float = 2.5
-    cells_across: int = 48
+    cells_across: int = 40
     reach_cells: int = 2
     candidates: int = 6
     distinct_heading_deg: float = 10.0
@@ -94,6 +98,14 @@ def coarse_candidates(points: np.ndarray, ground_z: float, top_z: float,
     score_map, origin = _wall_map(walls, cell, config.reach_cells)
     centred = xy - xy.mean(axis=0)
     span = float(np.linalg.norm(np.ptp(centred, axis=0)))
+    scales = scales[scales * span <= MAX_SPREAD * float(np.linalg.norm(np.ptp(walls, axis=0)))]
+    if len(scales) == 0:
+        raise ValueError(
+            f"--city-model: at the least scale tried ({guess / config.scale_range:.3g}, from "
+            f"the building's height) the photos' points spread over {MAX_SPREAD:g} times the "
+            f"model's extent or more: the model must hold what the photos see (give the "
+            f"folder of the city model's files, for the neighbours), or the photos do not "
+            f"show the building's foot and top")
     size = [fft.next_fast_len(n + int(np.ceil(scales[-1] * span / cell)) + 2, True)
             for n in score_map.shape]
     map_f = fft.rfft2(score_map, size)
