@@ -5,11 +5,12 @@ The photos' levelled sparse points ``p`` (z up, any scale) go to the city model'
 ``x = scale * turn_z(heading) @ p + shift_m`` (:class:`PlacedSimilarity`): five unknowns, up
 being known already. The model's surfaces are sampled every :data:`SAMPLE_SPACING_M`
 (:func:`surface_samples`); each point's nearest sample gives the plane it is compared with.
-Each Gauss-Newton step minimises ``sum (n · (x - y) / scale)²`` over the points within the trim
-distance of their plane (and within it plus twice the sample spacing of their sample), on the side of it that faces
-the camera nearest to them, for (log scale, heading, shift); the trim distance shrinks along
-:data:`TRIMS_M`. The facing test tells a street front from its mirror image: turned half
-round, the points of a row of facades land on the same walls, seen from behind.
+Each Gauss-Newton step minimises ``sum (n · (x - y) / scale)²`` (in the points' own units:
+in metres, shrinking the points onto one spot would zero every residual) over the points
+within the trim distance of their plane (and within it plus twice the sample spacing of
+their sample), on the side of it that faces the camera nearest to them (a point is not
+seen through a wall), for (log scale, heading, shift); the trim distance shrinks along
+:data:`TRIMS_M`.
 
 Walls alone leave the height free, so one more observation holds it: the points' ground
 (their :data:`~dataset.importers.photos.metric_frame.GROUND_PERCENTILE` along up, a point

@@ -4,14 +4,16 @@
 Seen from above, the photos' points on facades lie on the model's wall lines. For every
 heading on a grid (:attr:`SearchConfig.heading_step_deg`) and every scale on a log grid
 (:attr:`SearchConfig.scale_step`, a factor of :attr:`SearchConfig.scale_range` either side
-of :func:`scale_guess`), the levelled points' ground projection is binned on a grid
-(:attr:`SearchConfig.cells_across` cells across the model's walls) and correlated (FFT)
-with a map of the model's walls that is 1 on a wall and falls to 0
-:attr:`SearchConfig.reach_cells` cells away (a chamfer score from the distance transform): the correlation's peak is the best horizontal shift for that
-heading and scale, its value the number of points it brings near a wall. The best few
-distinct peaks (:func:`coarse_candidates`) go to the refinement
-(:mod:`dataset.importers.photos.city_icp`). The height comes from the ground: the points'
-ground at the building's lowest ground point, z = 0.
+of :func:`scale_guess`; scales that spread the points over :data:`MAX_SPREAD` times the
+model's extent are left out), the levelled points' ground projection is binned on a grid
+(:attr:`SearchConfig.cells_across` cells across the model's walls, at most 1 m) and correlated (FFT)
+with a map of the walls that is 1 on a wall and falls to 0
+:attr:`SearchConfig.reach_cells` cells away (a chamfer score from the distance
+transform): the correlation's peak is the best horizontal shift for that heading and
+scale, its value the number of points it brings near a wall. The best few distinct peaks
+(:func:`coarse_candidates`) go to the refinement (:mod:`dataset.importers.photos.city_icp`).
+The height comes from the ground: the points' ground at the building's lowest ground
+point, z = 0.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from dataset.importers.photos.city_icp import PlacedSimilarity, SurfaceSamples
 
 CLIP_PERCENTILES = (5.0, 95.0)
 """Points outside the box between these percentiles take no part in the coarse search."""
-MAX_SPREAD = 3.0
+MAX_SPREAD = 1.5
 """Scales at which those points' box would be wider than this many times the model walls'
 box are not tried: the model is assumed to hold what the photos see (the building and the
 neighbours round it), so their points spread no wider than it, with a margin."""
@@ -37,7 +39,8 @@ class SearchConfig:
     """The coarse search's grids; lengths in metres, angles in degrees.
 
     ``cells_across``: grid cells across the longer side of the walls' box (the cell is
-    that side over this); ``scale_range``: the scales tried run from ``guess / scale_range`` to
+    that side over this, at most ``max_cell_m``: coarser cells cannot tell a street front
+    from the same points shrunk into a block's walls); ``scale_range``: the scales tried run from ``guess / scale_range`` to
     ``guess * scale_range`` (:func:`scale_guess`); ``scale_step``: the log step between
     them (0.12: 12 %); ``candidates``: distinct peaks kept; distinct means headings
     ``distinct_heading_deg`` apart, scales a factor ``exp(distinct_log_scale)`` apart or
@@ -46,7 +49,8 @@ class SearchConfig:
     heading_step_deg: float = 6.0
     scale_step: float = 0.12
     scale_range: float = 2.5
-    cells_across: int = 40
+    cells_across: int = 48
+    max_cell_m: float = 1.0
     reach_cells: int = 2
     candidates: int = 6
     distinct_heading_deg: float = 10.0
@@ -55,7 +59,8 @@ class SearchConfig:
 
     def __post_init__(self) -> None:
         if not (0 < self.heading_step_deg <= 30 and 0 < self.scale_step <= 0.5
-                and self.scale_range >= 1 and self.cells_across >= 8 and self.reach_cells >= 1
+                and self.scale_range >= 1 and self.cells_across >= 8 and self.max_cell_m > 0
+                and self.reach_cells >= 1
                 and self.candidates >= 2):
             raise ValueError(f"search config out of range: {self}")
 
@@ -94,7 +99,7 @@ def coarse_candidates(points: np.ndarray, ground_z: float, top_z: float,
     steps = int(np.ceil(np.log(config.scale_range) / config.scale_step))
     scales = guess * np.exp(config.scale_step * np.arange(-steps, steps + 1))
     headings = np.radians(np.arange(0.0, 360.0, config.heading_step_deg))
-    cell = float(np.ptp(walls, axis=0).max()) / config.cells_across
+    cell = min(float(np.ptp(walls, axis=0).max()) / config.cells_across, config.max_cell_m)
     score_map, origin = _wall_map(walls, cell, config.reach_cells)
     centred = xy - xy.mean(axis=0)
     span = float(np.linalg.norm(np.ptp(centred, axis=0)))

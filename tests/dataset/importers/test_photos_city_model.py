@@ -17,8 +17,14 @@ from PIL import Image
 from scipy.spatial.transform import Rotation
 
 from dataset.generate import main as generate_main
-from dataset.importers.photos.city_fit import fit_city_model
-from dataset.importers.photos.city_icp import PlacedSimilarity
+from dataset.importers.photos.city_fit import (
+    CityFit,
+    CityFitConfig,
+    Solution,
+    check_fit,
+    fit_city_model,
+)
+from dataset.importers.photos.city_icp import PlacedSimilarity, Residuals
 from dataset.importers.photos.city_target import read_city_target
 from dataset.importers.photos.conventions import cam_from_world_cv
 from dataset.importers.photos.metric_frame import ScaleHint
@@ -57,15 +63,17 @@ def _levelled(building_m: np.ndarray) -> np.ndarray:
     return (building_m - TRUE.shift_m) @ TRUE.turn_z / TRUE.scale
 
 
-def _capture(target, rng, points: int = 1500, outliers: float = 0.2):
-    """Levelled points (on the surfaces with noise, plus outliers in the air and on the
-    street), camera centres round the building, the ground height and the top."""
+def _capture(target, rng, points: int = 1500, outliers: float = 0.2, street: float = 0.5):
+    """Levelled points (on the surfaces with noise, plus ``outliers`` times as many more:
+    the share ``street`` of them on the street, the rest in the air), camera centres round
+    the building, the ground height and the top."""
     tri = target.triangles_m
     on = _on_surfaces(tri, points, rng) + rng.normal(0, NOISE_M, (points, 3))
     lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
     k = int(outliers * points)
     air = rng.uniform([*lo[:2] - 10, 0.0], [*hi[:2] + 10, hi[2]], (k, 3))  # trees, cars
-    air[: k // 2, 2] = rng.normal(0.0, NOISE_M, k // 2)  # the street at the building's foot
+    on_street = int(street * k)
+    air[:on_street, 2] = rng.normal(0.0, NOISE_M, on_street)  # the street at the building's foot
     cameras = _ring((lo[:2] + hi[:2]) / 2, 1.5 * np.linalg.norm(hi[:2] - lo[:2]), 1.3 * hi[2])
     points_lev = _levelled(np.vstack([on, air]))
     z = points_lev[:, 2]
@@ -99,9 +107,36 @@ def test_too_few_points_are_refused(target):
 def test_points_of_another_place_are_refused(target):
     rng = np.random.default_rng(2)
     points, cameras, ground, top = _capture(target, rng)
-    points = rng.normal(0.0, 3.0, points.shape)  # a cloud that is no building
-    with pytest.raises(ValueError, match=r"only \d+ of \d+ sparse points .* lie within 0.5 m"):
-        fit_city_model(points, cameras, ground, top, target)
+    cloud = rng.normal(0.0, 3.0, points.shape)  # no building: spread far wider than the model
+    with pytest.raises(ValueError, match="points spread over 1.5 times the model's extent"):
+        fit_city_model(cloud, cameras, ground, top, target)
+
+
+def _fit(inliers: int, points: int, distance_m: float, runner_up: int | None = None):
+    """A fit whose best solution has ``inliers`` of ``points`` at ``distance_m`` (and a
+    runner-up, 90 degrees off, with ``runner_up`` inliers at the same distance)."""
+    def solution(k: int, heading_rad: float) -> Solution:
+        distance = np.full(points, np.inf)
+        distance[:k] = distance_m
+        return Solution(PlacedSimilarity(1.0, heading_rad, np.zeros(3)),
+                        Residuals(distance, np.zeros(points, int), np.isfinite(distance), 0.5))
+    other = None if runner_up is None else solution(runner_up, np.pi / 2)
+    return CityFit(solution(inliers, 0.0), other, points, 0.05)
+
+
+def test_the_refusal_rules_in_closed_form(target):
+    config = CityFitConfig()
+    check_fit(_fit(200, 1000, 0.01), target, config)  # 200 and 20 %: accepted
+    with pytest.raises(ValueError, match=r"only 199 of 1000 sparse points \(20%\) lie within"):
+        check_fit(_fit(199, 1000, 0.01), target, config)
+    with pytest.raises(ValueError, match=r"only 250 of 1500 sparse points \(17%\)"):
+        check_fit(_fit(250, 1500, 0.01), target, config)
+    check_fit(_fit(1000, 1500, 0.01, runner_up=799), target, config)  # ratio 0.799
+    with pytest.raises(ValueError, match="1000 and 800 points within 0.05 m of a surface, "
+                                         "ratio 0.80, refused from 0.8"):
+        check_fit(_fit(1000, 1500, 0.01, runner_up=800), target, config)
+    assert _fit(1000, 1500, 0.04, runner_up=1000).runner_up_ratio == 1.0
+    assert _fit(1000, 1500, 0.06, runner_up=1000).runner_up_ratio == 0.0  # beyond judge_m
 
 
 @pytest.mark.slow
