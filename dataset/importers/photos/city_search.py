@@ -6,8 +6,8 @@ heading on a grid (:attr:`SearchConfig.heading_step_deg`) and every scale on a l
 (:attr:`SearchConfig.scale_step`, a factor of :attr:`SearchConfig.scale_range` either side
 of :func:`scale_guess`; scales that spread the points over :data:`MAX_SPREAD` times the
 model's extent are left out), the levelled points' ground projection is binned on a grid
-(:attr:`SearchConfig.cells_across` cells across the model's walls, at most 1 m) and correlated (FFT)
-with a map of the walls that is 1 on a wall and falls to 0
+(:attr:`SearchConfig.cells_across` cells across the model's walls, at most 1 m) and
+correlated (FFT) with a map of the walls that is 1 on a wall and falls to 0
 :attr:`SearchConfig.reach_cells` cells away (a chamfer score from the distance
 transform): the correlation's peak is the best horizontal shift for that heading and
 scale, its value the number of points it brings near a wall. The best few distinct peaks
@@ -40,11 +40,12 @@ class SearchConfig:
 
     ``cells_across``: grid cells across the longer side of the walls' box (the cell is
     that side over this, at most ``max_cell_m``: coarser cells cannot tell a street front
-    from the same points shrunk into a block's walls); ``scale_range``: the scales tried run from ``guess / scale_range`` to
-    ``guess * scale_range`` (:func:`scale_guess`); ``scale_step``: the log step between
-    them (0.12: 12 %); ``candidates``: distinct peaks kept; distinct means headings
-    ``distinct_heading_deg`` apart, scales a factor ``exp(distinct_log_scale)`` apart or
-    the points' middle landing ``distinct_shift_m`` apart."""
+    from the same points shrunk into a block's walls); ``scale_range``: the scales tried
+    run from ``guess / scale_range`` to ``guess * scale_range`` (:func:`scale_guess`);
+    ``scale_step``: the log step between them (0.12: 12 %); ``candidates``: distinct peaks
+    kept; distinct means headings ``distinct_heading_deg`` apart, scales a factor
+    ``exp(distinct_log_scale)`` apart or the points' middle landing ``distinct_shift_m``
+    apart."""
 
     heading_step_deg: float = 6.0
     scale_step: float = 0.12
