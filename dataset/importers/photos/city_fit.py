@@ -158,7 +158,7 @@ def fit_city_model(points: np.ndarray, cameras: np.ndarray, ground_z: float, top
     low, high = (guess * np.exp(sign * config.search.scale_step) * config.search.scale_range
                  ** sign for sign in (-1, 1))
     solutions = []
-    for start in coarse + quarter_turns(coarse[0], middle):
+    for start in coarse:
         similarity, res = refine(points, cameras, ground, samples, start)
         if low <= similarity.scale <= high:  # else it ran off the scales searched
             solutions.append(Solution(similarity, res))
@@ -177,20 +177,6 @@ def fit_city_model(points: np.ndarray, cameras: np.ndarray, ground_z: float, top
     fit = CityFit(best, others[0] if others else None, len(points), judge)
     check_fit(fit, target, config)
     return fit
-
-
-def quarter_turns(start: PlacedSimilarity, middle: np.ndarray) -> list[PlacedSimilarity]:
-    """``start`` turned a quarter, a half and three quarters about the vertical through
-    where it takes the (3,) levelled point ``middle``: a building's symmetric alternatives,
-    always tried, so that a fit they match as well is found ambiguous."""
-    land = start.apply(middle[None])[0]
-    out = []
-    for k in (1, 2, 3):
-        turned = PlacedSimilarity(start.scale, start.heading_rad + k * np.pi / 2,
-                                  np.zeros(3))
-        out.append(PlacedSimilarity(start.scale, turned.heading_rad,
-                                    land - turned.apply(middle[None])[0]))
-    return out
 
 
 def check_fit(fit: CityFit, target: CityTarget, config: CityFitConfig) -> None:

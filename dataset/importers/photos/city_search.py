@@ -86,9 +86,12 @@ def scale_guess(ground_z: float, top_z: float, building_height_m: float) -> floa
 def coarse_candidates(points: np.ndarray, ground_z: float, top_z: float,
                       samples: SurfaceSamples, building_height_m: float,
                       config: SearchConfig = SearchConfig()) -> list[Candidate]:
-    """The best distinct peaks of the search (module docstring), best first, for (N, 3)
-    levelled points whose ground and top lie at heights ``ground_z`` and ``top_z``
-    (levelled frame), fitted to a model whose building is ``building_height_m`` tall."""
+    """The best distinct peaks of the search (module docstring), best first, then the
+    best peaks at the best one's scale and its heading turned a quarter, a half and three
+    quarters (a building's symmetric alternatives, always tried so that a fit they match as
+    well is found ambiguous), for (N, 3) levelled points whose ground and top lie at
+    heights ``ground_z`` and ``top_z`` (levelled frame), fitted to a model whose building
+    is ``building_height_m`` tall."""
     walls = samples.points_m[samples.vertical, :2]
     if len(walls) == 0:
         raise ValueError("the city model has no wall to fit the photos to")
@@ -123,20 +126,31 @@ def coarse_candidates(points: np.ndarray, ground_z: float, top_z: float,
             for score, shift in _best_shifts(scale * turned, map_f, score_map.shape, size,
                                              origin, cell, config.distinct_shift_m):
                 peaks.append((score / len(xy), heading, scale, shift))
-    peaks.sort(key=lambda p: -p[0])
     middle = xy.mean(axis=0)
     middle_3d = np.array([*middle, ground_z])
-    kept: list[Candidate] = []
-    for score, heading, scale, shift in peaks:
+
+    def candidate(peak: tuple) -> Candidate:
+        score, heading, scale, shift = peak
         c, s = np.cos(heading), np.sin(heading)
         shift_xy = shift - scale * np.array([[c, -s], [s, c]]) @ middle
-        candidate = Candidate(score, PlacedSimilarity(
-            float(scale), float(heading), np.array([*shift_xy, -scale * ground_z])))
-        if all(distinct(candidate.similarity, k.similarity, middle_3d, config)
-               for k in kept):
-            kept.append(candidate)
+        return Candidate(score, PlacedSimilarity(float(scale), float(heading),
+                                                 np.array([*shift_xy, -scale * ground_z])))
+
+    kept: list[Candidate] = []
+    for peak in sorted(peaks, key=lambda p: -p[0]):
+        c = candidate(peak)
+        if all(distinct(c.similarity, k.similarity, middle_3d, config) for k in kept):
+            kept.append(c)
             if len(kept) == config.candidates:
                 break
+    best = kept[0].similarity
+    for quarter in (1, 2, 3):  # the best one's symmetric alternatives, at its scale
+        heading = (best.heading_rad + quarter * np.pi / 2) % (2 * np.pi)
+        half_step = np.radians(config.heading_step_deg) / 2
+        same = [p for p in peaks if p[2] == best.scale
+                and abs((p[1] - heading + np.pi) % (2 * np.pi) - np.pi) <= half_step]
+        if same:
+            kept.append(candidate(max(same, key=lambda p: p[0])))
     return kept
 
 
