@@ -14,7 +14,8 @@ and the one farthest from it (from the true poses, as in bench/photos_from_rende
 errors after the best similarity (:mod:`dataset.importers.photos.pose_error`) and, for the
 city model, which puts the scene in the building's frame that the rendered scene is in too
 (``--citygml`` and the ``lod3`` preset import it so), the errors as they stand: heading
-(the similarity's turn about z, deg), camera positions (m) and orientations (deg).
+(the similarity's turn about z, deg), camera positions (m) and orientations (deg); the
+fit's other fits (the record's ``alternatives``) go to stderr.
 """
 
 from __future__ import annotations
@@ -69,7 +70,8 @@ def colmap_project(photos: Path, work: Path) -> Path:
 
 def row(label: str, project: Path, out: Path, scale: ScaleHint,
         truth: dict[str, np.ndarray]) -> list[str]:
-    """One table row: the photos source on ``project`` with ``scale``, against ``truth``."""
+    """One table row: the photos source on ``project`` with ``scale``, against ``truth``
+    (with a city model, the fit's other fits are printed on stderr)."""
     if out.exists():
         shutil.rmtree(out)
     start = time.perf_counter()
@@ -86,6 +88,13 @@ def row(label: str, project: Path, out: Path, scale: ScaleHint,
     if record["scale_source"] != "city_model":
         return [label, f"{len(names)} of {len(truth)}", f"{100 * errors.scale_error:.3f}",
                 "-", "-", "-", after, "-", f"{record['seconds']['metric_frame']:.1f}"]
+    fit = record["city_model"]
+    print(f"{label}: best fit {fit['inliers']} points within {fit['inlier_distance_m']} m, "
+          f"{fit['best_within_judge']} within {fit['judge_m']} m; other fits (heading deg, "
+          "scale, points within the same two):", file=sys.stderr)
+    for other in fit["alternatives"]:
+        print(f"  {other['heading_deg']:.2f} {other['scale_factor']:.4f} {other['inliers']} "
+              f"{other['within_judge']}", file=sys.stderr)
     _, turn, _ = similarity_alignment(posed[:, :3, 3], true[:, :3, 3])
     heading = np.degrees(np.arctan2(turn[1, 0], turn[0, 0]))
     position = np.linalg.norm(posed[:, :3, 3] - true[:, :3, 3], axis=1)
@@ -94,7 +103,7 @@ def row(label: str, project: Path, out: Path, scale: ScaleHint,
     return [label, f"{len(names)} of {len(truth)}", f"{100 * errors.scale_error:.3f}",
             f"{heading:+.3f}", f"{np.median(position):.3f} / {position.max():.3f}",
             f"{np.median(rotation):.3f} / {rotation.max():.3f}", after,
-            f"{record['city_model']['inlier_share']:.3f}",
+            f"{fit['inlier_share']:.3f}",
             f"{record['seconds']['metric_frame']:.1f} (all: {seconds:.0f})"]
 
 

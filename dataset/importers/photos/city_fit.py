@@ -86,15 +86,21 @@ class Solution:
 
 @dataclass(frozen=True)
 class CityFit:
-    """The best fit, the best distinct other one (``None``: every candidate came to the best
-    one), the points used and the yardstick ``judge_m`` the two are compared by: the best
-    fit's median inlier residual times ``judge_factor``, within ``min_judge_m`` and the
-    inlier distance (a fit as tight as the best one explains the points as well)."""
+    """The best fit, the other fits distinct from it and from each other (most points
+    within ``judge_m`` first; none where every start came to the best one), the points
+    used and the yardstick ``judge_m`` they are compared by: the best fit's median inlier
+    residual times ``judge_factor``, within ``min_judge_m`` and the inlier distance (a fit
+    as tight as the best one explains the points as well)."""
 
     best: Solution
-    runner_up: Solution | None
+    others: tuple[Solution, ...]
     points_used: int
     judge_m: float
+
+    @property
+    def runner_up(self) -> Solution | None:
+        """The strongest other fit, or ``None``."""
+        return self.others[0] if self.others else None
 
     @property
     def runner_up_ratio(self) -> float:
@@ -121,12 +127,11 @@ class CityFit:
                "rules": {"min_inliers": config.min_inliers,
                          "min_inlier_share": config.min_inlier_share,
                          "ambiguity_ratio": config.ambiguity_ratio}}
-        if self.runner_up is not None:
-            other = self.runner_up.similarity
-            out["runner_up"] = {"inliers": self.runner_up.inliers,
-                                "within_judge": self.runner_up.within(self.judge_m),
-                                "heading_deg": round(float(np.degrees(other.heading_rad)), 2),
-                                "scale_factor": other.scale}
+        out["best_within_judge"] = self.best.within(self.judge_m)
+        out["alternatives"] = [{"heading_deg": round(float(np.degrees(o.similarity.heading_rad)),
+                                                     2),
+                                "scale_factor": o.similarity.scale, "inliers": o.inliers,
+                                "within_judge": o.within(self.judge_m)} for o in self.others]
         return out
 
 
@@ -168,13 +173,16 @@ def fit_city_model(points: np.ndarray, cameras: np.ndarray, ground_z: float, top
                          f"its foot and top, or show another place: {FALLBACK}")
     solutions.sort(key=lambda s: -s.inliers)
     best = solutions[0]
-    others = [s for s in solutions[1:]
-              if distinct(best.similarity, s.similarity, middle, config.search)]
+    others: list[Solution] = []
+    for s in solutions[1:]:
+        if all(distinct(k.similarity, s.similarity, middle, config.search)
+               for k in [best, *others]):
+            others.append(s)
     residual = float(np.median(best.residuals.distance_m[best.residuals.inlier])) \
         if best.inliers else TRIMS_M[-1]
     judge = float(np.clip(config.judge_factor * residual, config.min_judge_m, TRIMS_M[-1]))
     others.sort(key=lambda s: -s.within(judge))
-    fit = CityFit(best, others[0] if others else None, len(points), judge)
+    fit = CityFit(best, tuple(others), len(points), judge)
     check_fit(fit, target, config)
     return fit
 

@@ -122,8 +122,8 @@ def _fit(inliers: int, points: int, distance_m: float, runner_up: int | None = N
         distance[:k] = distance_m
         return Solution(PlacedSimilarity(1.0, heading_rad, np.zeros(3)),
                         Residuals(distance, np.zeros(points, int), np.isfinite(distance), 0.5))
-    other = None if runner_up is None else solution(runner_up, np.pi / 2)
-    return CityFit(solution(inliers, 0.0), other, points, 0.05)
+    others = () if runner_up is None else (solution(runner_up, np.pi / 2),)
+    return CityFit(solution(inliers, 0.0), others, points, 0.05)
 
 
 def test_the_refusal_rules_in_closed_form(target):
