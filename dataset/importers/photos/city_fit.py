@@ -5,7 +5,8 @@ points fitted to the model's surfaces by a similarity about the vertical (scale,
 1. *Search* (:mod:`dataset.importers.photos.city_search`): headings and scales on grids,
    the horizontal shift by correlating the points' ground projection with the model's wall
    lines; the best :attr:`~dataset.importers.photos.city_search.SearchConfig.candidates`
-   distinct peaks are kept.
+   distinct peaks are kept, and the best shifts at the best peak's scale with its heading
+   turned a quarter, a half and three quarters.
 2. *Refine* each (:mod:`dataset.importers.photos.city_icp`): trimmed point-to-plane ICP with
    scale, down to the inlier distance
    :data:`~dataset.importers.photos.city_icp.TRIMS_M` ``[-1]``; the fit that brings the most
@@ -46,9 +47,14 @@ class CityFitConfig:
     ``max_points``: the sparse points used at most (drawn with a fixed seed);
     ``min_inliers`` and ``min_inlier_share``: the least count and share of them within the
     inlier distance of a model surface after the fit (fewer: a bad fit, refused);
+    ``min_on_building_share``: the least share of those inliers on the named building's
+    own surfaces (the photos show it; fewer: they were fitted to its neighbours alone, a bad
+    fit, refused);
     ``ambiguity_ratio``: a second, distinct fit (another heading, scale or place) bringing
     at least this share of the best one's points within the best one's own yardstick
-    (:meth:`CityFit.judge_m`) makes the fit ambiguous (refused).
+    (:attr:`CityFit.judge_m`: ``judge_factor`` times its median inlier residual, at least
+    ``min_judge_m`` metres and at most the inlier distance) makes the fit ambiguous
+    (refused).
     docs/decisions.md (2026-11-29, "Scale from a city model") says where the numbers come
     from."""
 
@@ -56,6 +62,7 @@ class CityFitConfig:
     max_points: int = 20000
     min_inliers: int = 200
     min_inlier_share: float = 0.2
+    min_on_building_share: float = 0.1
     ambiguity_ratio: float = 0.8
     judge_factor: float = 3.0
     min_judge_m: float = 0.05
@@ -88,14 +95,16 @@ class Solution:
 class CityFit:
     """The best fit, the other fits distinct from it and from each other (most points
     within ``judge_m`` first; none where every start came to the best one), the points
-    used and the yardstick ``judge_m`` they are compared by: the best fit's median inlier
-    residual times ``judge_factor``, within ``min_judge_m`` and the inlier distance (a fit
-    as tight as the best one explains the points as well)."""
+    used, the yardstick ``judge_m`` they are compared by (the best fit's median inlier
+    residual times ``judge_factor``, within ``min_judge_m`` and the inlier distance: a fit
+    as tight as the best one explains the points as well), and the share of the best fit's
+    inliers on the building's own surfaces."""
 
     best: Solution
     others: tuple[Solution, ...]
     points_used: int
     judge_m: float
+    on_building_share: float
 
     @property
     def runner_up(self) -> Solution | None:
@@ -118,6 +127,7 @@ class CityFit:
                "points_used": self.points_used, "inliers": self.best.inliers,
                "inlier_share": round(self.best.inliers / self.points_used, 4),
                "inlier_distance_m": res.trim_m,
+               "on_building_share": round(self.on_building_share, 4),
                "residual_median_m": round(float(np.median(inlier)), 4),
                "residual_rms_m": round(float(np.sqrt(np.mean(inlier ** 2))), 4),
                "scale_factor": self.best.similarity.scale,
@@ -126,6 +136,7 @@ class CityFit:
                "runner_up_ratio": round(self.runner_up_ratio, 4),
                "rules": {"min_inliers": config.min_inliers,
                          "min_inlier_share": config.min_inlier_share,
+                         "min_on_building_share": config.min_on_building_share,
                          "ambiguity_ratio": config.ambiguity_ratio}}
         out["best_within_judge"] = self.best.within(self.judge_m)
         out["alternatives"] = [{"heading_deg": round(float(np.degrees(o.similarity.heading_rad)),
@@ -154,7 +165,7 @@ def fit_city_model(points: np.ndarray, cameras: np.ndarray, ground_z: float, top
     if len(points) > config.max_points:
         rng = np.random.default_rng(POINT_SEED)
         points = points[np.sort(rng.choice(len(points), config.max_points, replace=False))]
-    samples = surface_samples(target.triangles_m)
+    samples = surface_samples(target.triangles_m, target.building_triangles)
     ground = np.array([*np.median(points[:, :2], axis=0), ground_z])
     middle = np.median(points, axis=0)
     coarse = [c.similarity for c in coarse_candidates(
@@ -182,15 +193,18 @@ def fit_city_model(points: np.ndarray, cameras: np.ndarray, ground_z: float, top
         if best.inliers else TRIMS_M[-1]
     judge = float(np.clip(config.judge_factor * residual, config.min_judge_m, TRIMS_M[-1]))
     others.sort(key=lambda s: -s.within(judge))
-    fit = CityFit(best, tuple(others), len(points), judge)
+    res = best.residuals
+    on_building = float(samples.own[res.nearest[res.inlier]].mean()) if best.inliers else 0.0
+    fit = CityFit(best, tuple(others), len(points), judge, on_building)
     check_fit(fit, target, config)
     return fit
 
 
 def check_fit(fit: CityFit, target: CityTarget, config: CityFitConfig) -> None:
     """Refuse a bad fit (fewer than ``min_inliers`` or ``min_inlier_share`` of the points
-    near a surface) or an ambiguous one (a distinct runner-up at ``ambiguity_ratio`` of the
-    best's inliers or more).
+    near a surface, or under ``min_on_building_share`` of those on the building itself) or
+    an ambiguous one (a distinct runner-up with ``ambiguity_ratio`` of
+    the best one's points within ``fit.judge_m``, or more).
 
     Raises
     ------
@@ -207,6 +221,12 @@ def check_fit(fit: CityFit, target: CityTarget, config: CityFitConfig) -> None:
             f"least {config.min_inliers} and {config.min_inlier_share:.0%} must: the photos "
             f"show another place or another building (check --city-building), or the model "
             f"too little of what they show: {FALLBACK}")
+    if fit.on_building_share < config.min_on_building_share:
+        raise ValueError(
+            f"--city-model: the best fit puts {fit.on_building_share:.0%} of the "
+            f"{fit.best.inliers} points near a surface on building {target.building} itself, "
+            f"the rest on its neighbours; at least {config.min_on_building_share:.0%} must lie "
+            f"on the building the photos show: check --city-building, or {FALLBACK}")
     if fit.runner_up is not None and fit.runner_up_ratio >= config.ambiguity_ratio:
         a, b = fit.best.similarity, fit.runner_up.similarity
         raise ValueError(

@@ -63,12 +63,14 @@ class PlacedSimilarity:
 @dataclass(frozen=True)
 class SurfaceSamples:
     """Points on the model's surfaces ((S, 3), m), their triangles' unit normals ((S, 3)),
-    a KD-tree of the points and which of them lie on vertical surfaces ((S,) bool)."""
+    a KD-tree of the points, which of them lie on vertical surfaces and which on the
+    building's own ((S,) bool each)."""
 
     points_m: np.ndarray
     normals: np.ndarray
     tree: cKDTree
     vertical: np.ndarray
+    own: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -83,10 +85,10 @@ class Residuals:
     trim_m: float
 
 
-def surface_samples(triangles_m: np.ndarray, spacing_m: float = SAMPLE_SPACING_M
-                    ) -> SurfaceSamples:
+def surface_samples(triangles_m: np.ndarray, own_triangles: int,
+                    spacing_m: float = SAMPLE_SPACING_M) -> SurfaceSamples:
     """Samples on (T, 3, 3) triangles, about ``spacing_m`` apart (at least one per
-    triangle), drawn with a fixed seed.
+    triangle), drawn with a fixed seed; the first ``own_triangles`` are the building's.
 
     Raises
     ------
@@ -99,7 +101,8 @@ def surface_samples(triangles_m: np.ndarray, spacing_m: float = SAMPLE_SPACING_M
     keep = area > 1e-9
     if not keep.any():
         raise ValueError("the city model has no surface with an area to fit the photos to")
-    tri, cross, area = tri[keep], cross[keep], area[keep]
+    own = np.arange(len(tri)) < own_triangles
+    tri, cross, area, own = tri[keep], cross[keep], area[keep], own[keep]
     normals = cross / (2.0 * area[:, None])
     count = np.maximum(1, np.ceil(area / spacing_m ** 2).astype(np.int64))
     owner = np.repeat(np.arange(len(tri)), count)
@@ -110,7 +113,7 @@ def surface_samples(triangles_m: np.ndarray, spacing_m: float = SAMPLE_SPACING_M
     t = tri[owner]
     points = t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
     return SurfaceSamples(points, normals[owner], cKDTree(points),
-                          np.abs(normals[owner, 2]) < 0.5)
+                          np.abs(normals[owner, 2]) < 0.5, own[owner])
 
 
 def residuals(world_m: np.ndarray, cameras_m: np.ndarray, samples: SurfaceSamples,

@@ -78,14 +78,16 @@ class CityTarget:
 def read_city_target(path: str | Path, building_id: str | None = None) -> CityTarget:
     """The city model at ``path`` (a CityGML file or a folder of them: one city model) and
     its building ``building_id`` (the scene name ``--citygml`` gives it, or its
-    ``gml:id``; ``None``: the model's only building).
+    ``gml:id`` where no scene has that name and one building that id; ``None``: the
+    model's only building).
 
     Raises
     ------
     CityGmlError (a ValueError)
         A file that is not readable CityGML (as
         :func:`~dataset.importers.citygml.read.read_citygml`), no building of that id, no id
-        given for a model of several buildings, or a building without a visible surface.
+        given for a model of several buildings, a gml:id that several buildings share, or a
+        building without a wall.
     """
     files = citygml_files(path)
     models = [read_citygml(f) for f in files]
@@ -123,9 +125,15 @@ def _chosen(path: str | Path, buildings: list[tuple[int, CityBuilding]],
         raise CityGmlError(
             f"{path} holds {len(buildings)} buildings: say which one the photos show with "
             f"--city-building ID (e.g. {', '.join(names[:5])}{' ...' if len(names) > 5 else ''})")
-    for n, (_, b) in enumerate(buildings):
-        if building_id in (b.gml_id, b.attributes.get("gml:id")):
-            return n
+    if names.count(building_id) == 1:
+        return names.index(building_id)
+    by_gml = [n for n, (_, b) in enumerate(buildings) if b.attributes.get("gml:id") == building_id]
+    if len(by_gml) == 1:
+        return by_gml[0]
+    if len(by_gml) > 1:  # files of one city model that repeat a gml:id
+        raise CityGmlError(f"{path}: {len(by_gml)} buildings have the gml:id {building_id!r}: "
+                           f"give the scene name instead, one of "
+                           f"{', '.join(names[n] for n in by_gml)}")
     raise CityGmlError(f"{path} holds no building {building_id!r} (its buildings: "
                        f"{', '.join(names[:8])}{' ...' if len(names) > 8 else ''})")
 

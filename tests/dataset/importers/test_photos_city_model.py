@@ -114,16 +114,18 @@ def test_points_of_another_place_are_refused(target):
         fit_city_model(cloud, cameras, ground, top, target)
 
 
-def _fit(inliers: int, points: int, distance_m: float, runner_up: int | None = None):
-    """A fit whose best solution has ``inliers`` of ``points`` at ``distance_m`` (and a
-    runner-up, 90 degrees off, with ``runner_up`` inliers at the same distance)."""
+def _fit(inliers: int, points: int, distance_m: float, runner_up: int | None = None,
+         on_building: float = 0.5):
+    """A fit whose best solution has ``inliers`` of ``points`` at ``distance_m``, the share
+    ``on_building`` of them on the building (and a runner-up, 90 degrees off, with
+    ``runner_up`` inliers at the same distance)."""
     def solution(k: int, heading_rad: float) -> Solution:
         distance = np.full(points, np.inf)
         distance[:k] = distance_m
         return Solution(PlacedSimilarity(1.0, heading_rad, np.zeros(3)),
                         Residuals(distance, np.zeros(points, int), np.isfinite(distance), 0.5))
     others = () if runner_up is None else (solution(runner_up, np.pi / 2),)
-    return CityFit(solution(inliers, 0.0), others, points, 0.05)
+    return CityFit(solution(inliers, 0.0), others, points, 0.05, on_building)
 
 
 def test_the_refusal_rules_in_closed_form(target):
@@ -133,6 +135,10 @@ def test_the_refusal_rules_in_closed_form(target):
         check_fit(_fit(199, 1000, 0.01), target, config)
     with pytest.raises(ValueError, match=r"only 250 of 1500 sparse points \(17%\)"):
         check_fit(_fit(250, 1500, 0.01), target, config)
+    check_fit(_fit(1000, 1500, 0.01, on_building=0.1), target, config)
+    with pytest.raises(ValueError, match="puts 9% of the 1000 points near a surface on "
+                                         "building 4018259 itself"):
+        check_fit(_fit(1000, 1500, 0.01, on_building=0.09), target, config)
     check_fit(_fit(1000, 1500, 0.01, runner_up=799), target, config)  # ratio 0.799
     with pytest.raises(ValueError, match="1000 and 800 points within 0.05 m of a surface, "
                                          "ratio 0.80, refused from 0.8"):
@@ -160,6 +166,19 @@ def test_a_neighbour_breaks_the_symmetry(tmp_path):
     got = fit_city_model(points, cameras, ground, top, street).best.similarity
     assert abs(got.scale / TRUE.scale - 1) < SCALE_TOL
     assert np.abs(got.shift_m - TRUE.shift_m).max() < SHIFT_TOL_M
+
+
+@pytest.mark.slow
+def test_photos_of_a_neighbour_alone_are_refused(tmp_path):
+    street = read_city_target(write_boxes(tmp_path / "street.gml", [
+        Box("sq", (0.0, 12.0), (0.0, 12.0), 9.0), Box("nb", (16.0, 24.0), (2.0, 30.0), 15.0)]),
+        "sq")
+    neighbour = read_city_target(write_boxes(tmp_path / "nb.gml", [
+        Box("nb", (16.0, 24.0), (2.0, 30.0), 15.0)]))
+    points, cameras, ground, top = _capture(neighbour, np.random.default_rng(7))
+    with pytest.raises(ValueError, match=r"puts 0% of the \d+ points near a surface on "
+                                         r"building sq itself"):
+        fit_city_model(points, cameras, ground, top, street)
 
 
 def test_a_model_of_several_buildings_needs_the_building_named(tmp_path):
