@@ -89,7 +89,8 @@ def row(label: str, project: Path, out: Path, scale: ScaleHint,
         return [label, f"{len(names)} of {len(truth)}", f"{100 * errors.scale_error:.3f}",
                 "-", "-", "-", after, "-", f"{record['seconds']['metric_frame']:.1f}"]
     fit = record["city_model"]
-    print(f"{label}: best fit {fit['inliers']} points within {fit['inlier_distance_m']} m, "
+    print(f"{label}: best fit {fit['inliers']} points within {fit['inlier_distance_m']} m "
+          f"({fit['on_building_share']:.0%} of them on the building itself), "
           f"{fit['best_within_judge']} within {fit['judge_m']} m; other fits (heading deg, "
           "scale, points within the same two):", file=sys.stderr)
     for other in fit["alternatives"]:

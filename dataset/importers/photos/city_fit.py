@@ -62,7 +62,7 @@ class CityFitConfig:
     max_points: int = 20000
     min_inliers: int = 200
     min_inlier_share: float = 0.2
-    min_on_building_share: float = 0.1
+    min_on_building_share: float = 0.25
     ambiguity_ratio: float = 0.8
     judge_factor: float = 3.0
     min_judge_m: float = 0.05

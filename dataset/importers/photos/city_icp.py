@@ -35,6 +35,9 @@ about that of the facade it models (its sills, reveals and balconies left out)."
 STEPS_PER_TRIM = 10
 """Gauss-Newton steps at most per trim distance (it stops sooner when a step changes no
 point's place by a millimetre)."""
+MAX_STEP = 0.3
+"""The most one step changes the log scale (35 %) or the heading (17 degrees): a step
+further than that comes from a poor set of inliers and would throw the fit away."""
 GROUND_WEIGHT = 0.02
 """The ground observation's weight, as a share of the inliers' count."""
 SAMPLE_SEED = 0
@@ -149,6 +152,9 @@ def refine(points: np.ndarray, cameras: np.ndarray, ground_point: np.ndarray,
                 return fit, res
             step = _gauss_newton_step(world[res.inlier], res.nearest[res.inlier], fit,
                                       samples, ground_point)
+            if not np.all(np.isfinite(step)):  # a degenerate set of inliers: stop here
+                return fit, residuals(world, fit.apply(cameras), samples, trims_m[-1])
+            step[:2] = np.clip(step[:2], -MAX_STEP, MAX_STEP)
             moved = PlacedSimilarity(fit.scale * float(np.exp(step[0])),
                                      fit.heading_rad + float(step[1]), fit.shift_m + step[2:])
             change = np.abs(moved.apply(points) - world).max(axis=1)

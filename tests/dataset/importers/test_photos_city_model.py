@@ -135,10 +135,10 @@ def test_the_refusal_rules_in_closed_form(target):
         check_fit(_fit(199, 1000, 0.01), target, config)
     with pytest.raises(ValueError, match=r"only 250 of 1500 sparse points \(17%\)"):
         check_fit(_fit(250, 1500, 0.01), target, config)
-    check_fit(_fit(1000, 1500, 0.01, on_building=0.1), target, config)
-    with pytest.raises(ValueError, match="puts 9% of the 1000 points near a surface on "
+    check_fit(_fit(1000, 1500, 0.01, on_building=0.25), target, config)
+    with pytest.raises(ValueError, match="puts 24% of the 1000 points near a surface on "
                                          "building 4018259 itself"):
-        check_fit(_fit(1000, 1500, 0.01, on_building=0.09), target, config)
+        check_fit(_fit(1000, 1500, 0.01, on_building=0.24), target, config)
     check_fit(_fit(1000, 1500, 0.01, runner_up=799), target, config)  # ratio 0.799
     with pytest.raises(ValueError, match="1000 and 800 points within 0.05 m of a surface, "
                                          "ratio 0.80, refused from 0.8"):
@@ -159,7 +159,7 @@ def test_a_square_building_seen_all_round_is_ambiguous(tmp_path):
 @pytest.mark.slow
 def test_a_neighbour_breaks_the_symmetry(tmp_path):
     path = write_boxes(tmp_path / "street.gml", [
-        Box("sq", (0.0, 12.0), (0.0, 12.0), 9.0), Box("nb", (16.0, 24.0), (2.0, 30.0), 15.0)])
+        Box("sq", (0.0, 12.0), (0.0, 12.0), 9.0), Box("nb", (16.0, 24.0), (2.0, 20.0), 12.0)])
     street = read_city_target(path, "sq")
     assert street.neighbours == ("street.gml#nb",)
     points, cameras, ground, top = _capture(street, np.random.default_rng(4))
@@ -171,10 +171,10 @@ def test_a_neighbour_breaks_the_symmetry(tmp_path):
 @pytest.mark.slow
 def test_photos_of_a_neighbour_alone_are_refused(tmp_path):
     street = read_city_target(write_boxes(tmp_path / "street.gml", [
-        Box("sq", (0.0, 12.0), (0.0, 12.0), 9.0), Box("nb", (16.0, 24.0), (2.0, 30.0), 15.0)]),
+        Box("sq", (0.0, 12.0), (0.0, 12.0), 9.0), Box("nb", (16.0, 24.0), (2.0, 20.0), 12.0)]),
         "sq")
     neighbour = read_city_target(write_boxes(tmp_path / "nb.gml", [
-        Box("nb", (16.0, 24.0), (2.0, 30.0), 15.0)]))
+        Box("nb", (16.0, 24.0), (2.0, 20.0), 12.0)]))
     points, cameras, ground, top = _capture(neighbour, np.random.default_rng(7))
     with pytest.raises(ValueError, match=r"puts 0% of the \d+ points near a surface on "
                                          r"building sq itself"):
