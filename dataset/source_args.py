@@ -92,6 +92,15 @@ def add_import_arguments(parser: argparse.ArgumentParser) -> None:
                         help="the scale and true north from the photos' EXIF GPS positions "
                              f"(at least {MIN_FIXES} photos with a fix, spread {MIN_SPREAD_M:g} m "
                              "or more about their mean; +y becomes north, x east)")
+    photos.add_argument("--city-model", type=Path, metavar="FILE_OR_DIR",
+                        help="the scale, north and place from a CityGML model (LoD2 or LoD3; "
+                             "a file or a folder of them, one city model) of the building the "
+                             "photos show and its neighbours: the sparse points are fitted to "
+                             "its walls and roofs; the scene lands in the building's frame as "
+                             "--citygml imports it, +y the CRS's grid north")
+    photos.add_argument("--city-building", metavar="ID",
+                        help="with --city-model: the building the photos show (its scene name "
+                             "or gml:id), where the model holds several")
 
 
 def chosen_source(args: argparse.Namespace, sources: Sequence[Source]) -> tuple[Source, str]:
@@ -127,13 +136,14 @@ def source_options(source: Source, args: argparse.Namespace, *, building_id: str
     if args.ifc_classes is not None:
         raise ValueError(f"--ifc-classes goes with --ifc, not with {source.flag}")
     scale_given = (args.known_distance is not None or args.known_height is not None
-                   or args.gps)
+                   or args.gps or args.city_model is not None
+                   or args.city_building is not None)
     if source.options_type is PhotosOptions:
         return PhotosOptions(photos_scale_from_args(args) if scale_given else None,
                              progress=progress)
     if scale_given:
-        raise ValueError(f"--known-distance, --known-height and --gps go with --photos, not "
-                         f"with {source.flag}")
+        raise ValueError(f"--known-distance, --known-height, --gps and --city-model go with "
+                         f"--photos, not with {source.flag}")
     if source.options_type is NoOptions:
         return NoOptions()
     raise ValueError(f"source {source.name} reads {source.options_type.__name__}, which the "
@@ -154,7 +164,8 @@ def import_config_from_args(args: argparse.Namespace) -> ImportConfig:
 
 
 def photos_scale_from_args(args: argparse.Namespace) -> ScaleHint:
-    """The :class:`ScaleHint` of ``--known-distance`` / ``--known-height`` / ``--gps``.
+    """The :class:`ScaleHint` of ``--known-distance`` / ``--known-height`` / ``--gps`` /
+    ``--city-model`` (and ``--city-building``).
 
     Raises
     ------
@@ -169,7 +180,8 @@ def photos_scale_from_args(args: argparse.Namespace) -> ScaleHint:
         except ValueError:
             raise ValueError(f"--known-distance PHOTO_A PHOTO_B METRES: {metres!r} is not a "
                              "number of metres") from None
-    return ScaleHint(known, args.known_height, gps=args.gps)
+    return ScaleHint(known, args.known_height, gps=args.gps, city_model=args.city_model,
+                     city_building=args.city_building)
 
 
 def _by_flag(sources: Sequence[Source]) -> dict[str, list[Source]]:

@@ -128,7 +128,7 @@ def building_from_citygml(model: CityModel, building: CityBuilding, *,
     if not any(s.kind == "wall" for s in surfaces):
         raise CityGmlError(f"{where} has no WallSurface polygon with an area; a benchmark "
                            "building needs its walls (LoD2 or LoD3 boundary surfaces)")
-    offset, ground_z, centre_xy = _offset(surfaces, config, warnings)
+    offset, ground_z, centre_xy = recentre_offset(surfaces, config, warnings)
     surfaces = [_moved(s, offset) for s in surfaces]
     if _enclosed_volume_m3(surfaces) < 0:
         surfaces = [_flipped(s) for s in surfaces]
@@ -193,11 +193,12 @@ def _warning_kind(message: str) -> str:
     return message.split(": ", 1)[-1]
 
 
-def _offset(surfaces: list[Surface], config: CityGmlConfig, warnings: Counter
-            ) -> tuple[np.ndarray, float, tuple[float, float]]:
+def recentre_offset(surfaces: list[Surface], config: CityGmlConfig, warnings: Counter
+                    ) -> tuple[np.ndarray, float, tuple[float, float]]:
     """The shift (3,) that puts the lowest ground-surface point at z = 0 and the ground
     surface's x/y bounding-box centre at the origin (walls without a ground surface), that
-    lowest z and that centre (file CRS, metres)."""
+    lowest z and that centre (file CRS, metres). A photos scene fitted to the city model
+    (:mod:`dataset.importers.photos.city_target`) lands in the same frame."""
     ground = [s.tri.vertices_m for s in surfaces if s.kind == "ground"]
     if not ground:
         warnings["no GroundSurface: ground at the lowest wall point"] += 1

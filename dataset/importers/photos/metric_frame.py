@@ -12,21 +12,27 @@ knows (docs/importing.md, section 9, says what is assumed).
 - **Scale** from one thing the user knows: the distance between two cameras (two photos'
   names), or the building's height, taken as the span of the sparse points along up from
   their :data:`GROUND_PERCENTILE` to their :data:`TOP_PERCENTILE`; or from the photos' EXIF
-  GPS positions (:mod:`dataset.importers.photos.gps_fit`), which give true north too.
-  Nothing known: refused.
-- **Where**: with sparse points, the ground (z = 0) at their :data:`GROUND_PERCENTILE` along
-  up and the origin above their median; without (a nerfstudio file), the input's origin.
-- **North**: with GPS, the world's +y is true north and +x east; otherwise north is
-  unknown and +y is the way the first photo looks (level).
+  GPS positions (:mod:`dataset.importers.photos.gps_fit`), which give true north too; or
+  from a city model of the place (:mod:`dataset.importers.photos.city_fit`), which gives
+  north and the model's position too. Nothing known: refused.
+- **Where**: with a city model, its building's frame (as ``--citygml`` imports it); else,
+  with sparse points, the ground (z = 0) at their :data:`GROUND_PERCENTILE` along up and the
+  origin above their median; without (a nerfstudio file), the input's origin.
+- **North**: with GPS, the world's +y is true north and +x east; with a city model, +y is
+  its CRS's grid north; otherwise north is unknown and +y is the way the first photo looks
+  (level).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
+from dataset.importers.photos.city_fit import CityFitConfig, fit_city_model
+from dataset.importers.photos.city_target import CityTarget
 from dataset.importers.photos.gps import GpsFix
 from dataset.importers.photos.gps_frame import gps_frame
 
@@ -37,9 +43,11 @@ GROUND_PERCENTILE = 1.0
 TOP_PERCENTILE = 99.0
 """The sparse points' percentiles along up taken for the ground and the building's top (a
 few stray points below the ground or above the roof change nothing)."""
-SCALE_OPTIONS = "--known-distance PHOTO_A PHOTO_B METRES, --known-height METRES or --gps"
+SCALE_OPTIONS = ("--known-distance PHOTO_A PHOTO_B METRES, --known-height METRES, --gps or "
+                 "--city-model FILE_OR_DIR")
 NO_SCALE = (f"photos carry no scale: say what you know, with {SCALE_OPTIONS} (the photos' "
-            "EXIF GPS positions, which give north too; docs/importing.md, section 9)")
+            "EXIF GPS positions, or a CityGML model of the place, which give north too; "
+            "docs/importing.md, section 9)")
 
 
 @dataclass(frozen=True)
@@ -54,20 +62,26 @@ class KnownDistance:
 @dataclass(frozen=True)
 class ScaleHint:
     """What the user knows of the scale: one of a known distance between two cameras, the
-    building's height in metres, or ``gps``: the photos' EXIF GPS positions."""
+    building's height in metres, ``gps``: the photos' EXIF GPS positions, or
+    ``city_model``: a CityGML file or folder of the place (``city_building``: the id of the
+    building the photos show, where it holds several)."""
 
     known_distance: KnownDistance | None = None
     known_height_m: float | None = None
     gps: bool = False
+    city_model: Path | None = None
+    city_building: str | None = None
 
     def __post_init__(self) -> None:
         given = ((self.known_distance is not None) + (self.known_height_m is not None)
-                 + self.gps)
+                 + self.gps + (self.city_model is not None))
         if given == 0:
             raise ValueError(NO_SCALE)
         if given > 1:
             raise ValueError(f"give one scale, not {given}: {SCALE_OPTIONS}")
-        if self.gps:
+        if self.city_building is not None and self.city_model is None:
+            raise ValueError("--city-building names a building of --city-model: give both")
+        if self.gps or self.city_model is not None:
             return
         value = (self.known_distance.metres if self.known_distance is not None
                  else self.known_height_m)
@@ -120,8 +134,8 @@ def up_from_cameras(world_from_camera: np.ndarray) -> tuple[np.ndarray, str]:
 
 def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
                       points: np.ndarray | None, hint: ScaleHint,
-                      gps_fixes: Sequence[GpsFix | None] | None = None
-                      ) -> tuple[Similarity, dict]:
+                      gps_fixes: Sequence[GpsFix | None] | None = None,
+                      city: CityTarget | None = None) -> tuple[Similarity, dict]:
     """The similarity from the input frame to the world, and a record of what it assumed.
 
     Parameters
@@ -131,13 +145,17 @@ def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
     points : (M, 3) sparse points in the input frame, or ``None``
     gps_fixes : the N photos' EXIF GPS fixes (``None`` where a photo has none); needed
         with ``hint.gps``
+    city : the city model's surfaces (:func:`dataset.importers.photos.city_target.
+        read_city_target`); needed with ``hint.city_model``
 
     Raises
     ------
     ValueError
         A known distance names a photo that has no pose, or two cameras at one place; a
         known height without sparse points; GPS fixes too few, too close together or
-        disagreeing (:func:`dataset.importers.photos.gps_fit.fit_gps`).
+        disagreeing (:func:`dataset.importers.photos.gps_fit.fit_gps`); a city model
+        without sparse points, or a fit to it that is bad or ambiguous
+        (:func:`dataset.importers.photos.city_fit.fit_city_model`).
     """
     poses = np.asarray(world_from_camera, dtype=np.float64)
     up, up_how = up_from_cameras(poses)
@@ -147,6 +165,8 @@ def metric_similarity(world_from_camera: np.ndarray, names: Sequence[str],
                          "photo taken level first")
     right /= np.linalg.norm(right)
     rotation = np.stack([right, np.cross(up, right), up])
+    if hint.city_model is not None:
+        return _city_similarity(poses, points, rotation, up_how, city)
     if hint.gps:
         if gps_fixes is None or len(gps_fixes) != len(poses):
             raise ValueError("--gps needs each posed photo's GPS fix (None where it has none)")
@@ -202,3 +222,33 @@ def _scale(poses: np.ndarray, names: list[str], points: np.ndarray | None, up: n
     return hint.known_height_m / span, (
         f"known building height {hint.known_height_m:g} m over the sparse points' "
         f"{GROUND_PERCENTILE:g}th to {TOP_PERCENTILE:g}th percentile along up")
+
+
+def _city_similarity(poses: np.ndarray, points: np.ndarray | None, level: np.ndarray,
+                     up_how: str, city: CityTarget | None) -> tuple[Similarity, dict]:
+    """The similarity that the fit to the city model gives, and its record."""
+    if city is None:
+        raise ValueError("--city-model needs the city model read first (read_city_target)")
+    if points is None or len(points) == 0:
+        raise ValueError("--city-model needs the sparse points of structure from motion, "
+                         "which this input lacks: give --known-distance instead")
+    levelled = np.asarray(points, dtype=np.float64) @ level.T
+    ground_z, top_z = np.percentile(levelled[:, 2], (GROUND_PERCENTILE, TOP_PERCENTILE))
+    fit = fit_city_model(levelled, poses[:, :3, 3] @ level.T, float(ground_z), float(top_z),
+                         city)
+    best = fit.best.similarity
+    record = {"up": up_how,
+              "scale": (f"city model: the sparse points fitted to building {city.building} "
+                        f"and {len(city.neighbours)} neighbours ({fit.best.inliers} of "
+                        f"{fit.points_used} within {fit.best.residuals.trim_m:g} m of a "
+                        "surface)"),
+              "origin": (f"the city model's building frame: world = {city.crs} coordinates "
+                         f"+ offset_m {[round(float(x), 4) for x in city.offset_m]} (as "
+                         "--citygml imports the building)"),
+              "scale_source": "city_model", "north_known": True,
+              "north": (f"grid north of {city.crs}: +y points along it, +x east; true north "
+                        f"lies {city.north_deg:.3f} degrees anticlockwise of +y (the "
+                        "meridian convergence)"),
+              "north_deg": city.north_deg,  # envelope.orientation: true north to +y, clockwise
+              "city_model": fit.record(city, CityFitConfig())}
+    return Similarity(best.scale, best.turn_z @ level, best.shift_m.copy()), record

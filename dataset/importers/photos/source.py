@@ -28,6 +28,7 @@ import numpy as np
 from PIL import ExifTags, Image
 from tqdm import tqdm
 
+from dataset.importers.photos.city_target import CityTarget, read_city_target
 from dataset.importers.photos.existing import (
     colmap_model_folder,
     read_colmap_project,
@@ -89,18 +90,22 @@ def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, .
     ValueError
         No scale given, or (a folder of photos) as
         :func:`dataset.importers.photos.photo_folder.list_photos`, a known distance naming
-        no photo, or (``--gps``) too few GPS fixes or fixes too close together.
+        no photo, (``--gps``) too few GPS fixes or fixes too close together, or
+        (``--city-model``) a city model that is not readable CityGML or lacks the building
+        named (:func:`dataset.importers.photos.city_target.read_city_target`).
     """
     path = Path(path)
     if options.scale is None:
         raise ValueError(NO_SCALE)
+    city = None if options.scale.city_model is None else read_city_target(
+        options.scale.city_model, options.scale.city_building)
     if colmap_model_folder(path) is not None:
         return (SceneEntry(path.resolve().name, partial(
-            _write, partial(_read_posed, read_colmap_project), path, options)),)
+            _write, partial(_read_posed, read_colmap_project), path, options, city)),)
     if transforms_file(path) is not None:
         folder = path if path.is_dir() else path.parent
         return (SceneEntry(folder.resolve().name, partial(
-            _write, partial(_read_posed, read_nerfstudio), path, options)),)
+            _write, partial(_read_posed, read_nerfstudio), path, options, city)),)
     photos = list_photos(path)
     known = options.scale.known_distance
     missing = [] if known is None else [n for n in (known.photo_a, known.photo_b)
@@ -112,7 +117,7 @@ def read_photos(path: str | Path, options: PhotosOptions) -> tuple[SceneEntry, .
         check_photo_fixes([read_gps_fix(p.path) for p in photos])
     return (SceneEntry(path.resolve().name, partial(_write, partial(_structure_from_motion,
                                                                     photos, options.sfm),
-                                                    path, options)),)
+                                                    path, options, city)),)
 
 
 def detect_photos(path: str | Path) -> bool:
@@ -172,9 +177,10 @@ def _read_alike_by_colmap(path: Path) -> bool:
 
 
 def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
-           options: PhotosOptions, out_dir: Path) -> Scene:
+           options: PhotosOptions, city: CityTarget | None, out_dir: Path) -> Scene:
     """Pose the photos of ``path`` with ``read`` (which times its own stages), take them to
-    metres and z up, and write the scene into ``out_dir``."""
+    metres and z up (``city``: the city model read for ``--city-model``), and write the
+    scene into ``out_dir``."""
     times = StageTimes()
     posed = read(path, times)
     names = [p.name for p in posed.photos]
@@ -184,7 +190,7 @@ def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
         similarity, frame_record = metric_similarity(
             np.stack([p.world_from_camera for p in posed.photos]), names, posed.points,
             options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
-            if options.scale.gps else None)
+            if options.scale.gps else None, city)
     (out_dir / "images").mkdir()
     threads = (os.cpu_count() or 1) if options.sfm.threads == -1 else options.sfm.threads
     with times.stage(WRITING), ThreadPoolExecutor(threads) as pool:
@@ -218,6 +224,6 @@ PHOTOS_SOURCE = Source(
     name="photos", flag="--photos",
     help="a folder of JPEG or PNG photos of one building (poses from structure from motion), "
          "a COLMAP project (sparse/0 and images/) or a nerfstudio transforms.json; needs "
-         "--known-distance, --known-height or --gps for the scale",
+         "--known-distance, --known-height, --gps or --city-model for the scale",
     detect=detect_photos, read=read_photos, options_type=PhotosOptions,
 )

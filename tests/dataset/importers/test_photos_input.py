@@ -102,8 +102,8 @@ def test_heic_photos_are_refused_with_the_fix(tmp_path, capsys):
 def test_no_scale_is_refused_before_anything_runs(tmp_path, capsys):
     folder = _folder(tmp_path)
     code, err = _generate(capsys, "--photos", folder, "--out", tmp_path / "out")
-    assert code == 2 and ("--known-distance PHOTO_A PHOTO_B METRES, --known-height METRES "
-                          "or --gps") in err
+    assert code == 2 and ("--known-distance PHOTO_A PHOTO_B METRES, --known-height METRES, "
+                          "--gps or --city-model FILE_OR_DIR") in err
     assert not (tmp_path / "out").exists()
     code, err = _generate(capsys, "--photos", folder, "--out", tmp_path / "out",
                           "--known-distance", "p0.png", "nowhere.png", "2")
