@@ -51,6 +51,7 @@ from dataset.importers.photos.posed import (
     sparse_points,
     undistorted_rgb,
 )
+from dataset.importers.photos.preemptive_pairs import ExhaustiveMatching, PreemptiveMatching
 from dataset.importers.photos.sfm import SfmConfig, reconstruct
 from dataset.importers.photos.stage_times import (
     DEPTH,
@@ -148,7 +149,8 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                 else:
                     Image.fromarray(rgb).save(upright / photo.name, format="PNG",
                                               compress_level=1)
-        model = reconstruct(photos, upright, Path(work), config, times)
+        built = reconstruct(photos, upright, Path(work), config, times)
+        model = built.model
         posed = from_reconstruction(model, upright, upright=True)
         # The upright copies go with the temporary folder: point back at the photos.
         posed = tuple(replace(p, path=path / p.name) for p in posed)
@@ -156,11 +158,22 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
         return PosedPhotos(posed, sparse_points(model),
                            tuple(p.name for p in photos if p.name not in placed),
                            {"input": "photos", "structure_from_motion": "COLMAP (pycolmap) "
-                            "incremental mapping, SIFT, exhaustive matching, CPU",
+                            "incremental mapping, SIFT, CPU",
+                            "matching": _matching_label(config.matching),
+                            "matched_pairs": built.matched_pairs,
+                            "all_pairs": built.all_pairs,
                             "sift_max_image_px": config.max_image_px,
                             "sift_max_features": config.max_features,
                             "mean_reprojection_error_px":
                                 round(float(model.compute_mean_reprojection_error()), 4)})
+
+
+def _matching_label(matching: PreemptiveMatching | ExhaustiveMatching) -> str:
+    if isinstance(matching, ExhaustiveMatching):
+        return "exhaustive (every pair)"
+    return (f"preemptive: pairs with >= {matching.min_matches} matches of their "
+            f"{matching.top_features} largest features, and each photo's "
+            f"{matching.min_partners} best")
 
 
 def _read_alike_by_colmap(path: Path) -> bool:
