@@ -25,7 +25,7 @@ class PreemptiveMatching:
     2026-11-29, "Preemptive matching")."""
 
     top_features: int = 200
-    min_matches: int = 4
+    min_matches: int = 6
     min_partners: int = 5
     max_ratio: float = 0.8
 
