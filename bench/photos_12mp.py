@@ -21,9 +21,9 @@ which other work on shared cores does not change. ``--views N`` poses N of the 1
 evenly spaced (a quick run). ``--max-image-px`` and ``--max-features`` set the
 structure-from-motion options of :class:`dataset.importers.photos.sfm.SfmConfig` (default:
 its defaults); ``--exhaustive`` matches every pair instead of the pairs preemptive matching
-keeps (the default; the table's "pairs matched"). With ``--photos DIR`` (a folder of photos) it poses those instead, with a
-stand-in ``--known-height`` of 10 m (the scale does not change the time), and reports no
-pose error.
+keeps (the default; the table's "pairs matched"). With ``--photos DIR`` (a folder of
+photos) it poses those instead, with a stand-in ``--known-height`` of 10 m (the scale does
+not change the time), and reports no pose error.
 """
 
 from __future__ import annotations

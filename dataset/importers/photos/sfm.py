@@ -113,22 +113,8 @@ def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path, config: 
     import pycolmap
 
     database = work_dir / "database.db"
-    extraction = pycolmap.FeatureExtractionOptions()
-    extraction.num_threads = config.threads
-    extraction.max_image_size = config.max_image_px
-    extraction.sift.max_num_features = config.max_features
     with times.stage(FEATURES):
-        for group in camera_groups(tuple(photos)).values():
-            reader = pycolmap.ImageReaderOptions()
-            reader.camera_model = "SIMPLE_RADIAL"
-            first = group[0]
-            if first.focal_px is not None:
-                reader.camera_params = f"{first.focal_px},{first.width / 2},{first.height / 2},0"
-            pycolmap.extract_features(database, upright_dir,
-                                      image_names=[p.name for p in group],
-                                      camera_mode=pycolmap.CameraMode.SINGLE,
-                                      reader_options=reader, extraction_options=extraction,
-                                      device=pycolmap.Device.cpu)
+        extract_features(photos, upright_dir, database, config)
     with times.stage(MATCHING):
         if isinstance(config.matching, PreemptiveMatching):
             pairs = preemptive_pairs(database, config.matching)
@@ -149,10 +135,32 @@ def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path, config: 
                                             mapping), matched
 
 
-def preemptive_pairs(database: Path, matching: PreemptiveMatching) -> list[tuple[str, str]]:
-    """The pairs of image names in COLMAP's ``database`` (features extracted) that
-    ``matching`` keeps (:func:`~dataset.importers.photos.preemptive_pairs.selected_pairs`),
-    each pair in name order, sorted."""
+def extract_features(photos: Sequence[Photo], upright_dir: Path, database: Path,
+                     config: SfmConfig) -> None:
+    """SIFT features of ``photos`` (upright copies in ``upright_dir``) into COLMAP's
+    ``database``, one shared camera per camera group."""
+    import pycolmap
+
+    extraction = pycolmap.FeatureExtractionOptions()
+    extraction.num_threads = config.threads
+    extraction.max_image_size = config.max_image_px
+    extraction.sift.max_num_features = config.max_features
+    for group in camera_groups(tuple(photos)).values():
+        reader = pycolmap.ImageReaderOptions()
+        reader.camera_model = "SIMPLE_RADIAL"
+        first = group[0]
+        if first.focal_px is not None:
+            reader.camera_params = f"{first.focal_px},{first.width / 2},{first.height / 2},0"
+        pycolmap.extract_features(database, upright_dir, image_names=[p.name for p in group],
+                                  camera_mode=pycolmap.CameraMode.SINGLE, reader_options=reader,
+                                  extraction_options=extraction, device=pycolmap.Device.cpu)
+
+
+def preliminary_counts(database: Path, top_features: int,
+                       max_ratio: float) -> tuple[list[str], np.ndarray]:
+    """The image names in COLMAP's ``database`` (features extracted), sorted, and their
+    (n, n) preliminary matches on each one's ``top_features`` largest features
+    (:func:`~dataset.importers.photos.preemptive_pairs.preliminary_match_counts`)."""
     import pycolmap
 
     db = pycolmap.Database.open(database)
@@ -160,10 +168,16 @@ def preemptive_pairs(database: Path, matching: PreemptiveMatching) -> list[tuple
         images = sorted(db.read_all_images(), key=lambda im: im.name)
         top = [largest_scale_descriptors(np.asarray(db.read_descriptors(im.image_id).data),
                                          keypoint_scales_px(db.read_keypoints(im.image_id)),
-                                         matching.top_features) for im in images]
+                                         top_features) for im in images]
     finally:
         db.close()
-    counts = preliminary_match_counts(top, matching.max_ratio)
-    return sorted((images[i].name, images[j].name)
-                  for i, j in selected_pairs(counts, matching.min_matches,
-                                             matching.min_partners))
+    return [im.name for im in images], preliminary_match_counts(top, max_ratio)
+
+
+def preemptive_pairs(database: Path, matching: PreemptiveMatching) -> list[tuple[str, str]]:
+    """The pairs of image names in COLMAP's ``database`` (features extracted) that
+    ``matching`` keeps (:func:`~dataset.importers.photos.preemptive_pairs.selected_pairs`),
+    each pair in name order, sorted."""
+    names, counts = preliminary_counts(database, matching.top_features, matching.max_ratio)
+    return sorted((names[i], names[j]) for i, j in selected_pairs(counts, matching.min_matches,
+                                                                  matching.min_partners))

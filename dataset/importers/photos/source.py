@@ -209,7 +209,7 @@ def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
               "unposed": list(posed.unposed), "scale_factor": similarity.scale}
     scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
     with times.stage(DEPTH):
-        scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY)
+        scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY, threads=threads)
     scene = replace(scene, extra={**scene.extra, RECORD_KEY: {**scene.extra[RECORD_KEY],
                                                               **times.record()}})
     if options.progress:
