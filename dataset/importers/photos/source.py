@@ -139,16 +139,9 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
     with tempfile.TemporaryDirectory(prefix="photos-sfm-") as work:
         upright = Path(work) / "upright"
         upright.mkdir()
-        with times.stage(READING):
-            for photo in photos:
-                # Every photo is decoded here, before COLMAP sees it: a broken file stops the
-                # run.
-                rgb = read_photo_rgb(photo.path)
-                if _read_alike_by_colmap(photo.path):
-                    shutil.copyfile(photo.path, upright / photo.name)  # no encoding: faster
-                else:
-                    Image.fromarray(rgb).save(upright / photo.name, format="PNG",
-                                              compress_level=1)
+        with times.stage(READING), ThreadPoolExecutor(_threads(config)) as pool:
+            # Threads: decoding a photo leaves Python's lock.
+            list(pool.map(partial(_upright_copy, upright), photos))
         built = reconstruct(photos, upright, Path(work), config, times)
         model = built.model
         posed = from_reconstruction(model, upright, upright=True)
@@ -166,6 +159,21 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
                             "sift_max_features": config.max_features,
                             "mean_reprojection_error_px":
                                 round(float(model.compute_mean_reprojection_error()), 4)})
+
+
+def _upright_copy(upright: Path, photo: Photo) -> None:
+    """Decode ``photo`` (a broken file stops the run here, before COLMAP sees it) and put an
+    upright copy of it into ``upright`` under its name."""
+    rgb = read_photo_rgb(photo.path)
+    if _read_alike_by_colmap(photo.path):
+        shutil.copyfile(photo.path, upright / photo.name)  # no encoding: faster
+    else:
+        Image.fromarray(rgb).save(upright / photo.name, format="PNG", compress_level=1)
+
+
+def _threads(config: SfmConfig) -> int:
+    """The threads ``config`` asks for (-1: one per CPU core)."""
+    return (os.cpu_count() or 1) if config.threads == -1 else config.threads
 
 
 def _matching_label(matching: PreemptiveMatching | ExhaustiveMatching) -> str:
@@ -199,7 +207,7 @@ def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
             options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
             if options.scale.gps else None)
     (out_dir / "images").mkdir()
-    threads = (os.cpu_count() or 1) if options.sfm.threads == -1 else options.sfm.threads
+    threads = _threads(options.sfm)
     with times.stage(WRITING), ThreadPoolExecutor(threads) as pool:
         # Threads: decoding, undistorting and encoding a photo leave Python's lock.
         frames = list(tqdm(pool.map(partial(_write_photo, out_dir, similarity), posed.photos),
