@@ -21,8 +21,11 @@ class PreemptiveMatching:
     ``min_matches`` or more preliminary matches (mutual nearest neighbours passing the ratio
     test ``max_ratio``, COLMAP's own); each photo also keeps its ``min_partners`` best
     partners (ties included) whatever their count, so a photo with weak texture is not cut
-    off. Chosen on the photo-look renders of the tiny and lod3 presets (docs/decisions.md,
-    2026-11-29, "Preemptive matching")."""
+    off. Photos the largest model then leaves out get a second chance: each is matched with
+    every other photo and the mapping runs again (:mod:`dataset.importers.photos.sfm`): a
+    weak link the preliminary matches missed costs time, not photos. Chosen on the
+    photo-look renders of the tiny preset (docs/decisions.md, 2026-11-29, "Preemptive
+    matching")."""
 
     top_features: int = 200
     min_matches: int = 6

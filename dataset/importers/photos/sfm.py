@@ -109,30 +109,59 @@ def reconstruct(photos: Sequence[Photo], upright_dir: Path, work_dir: Path,
 
 def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path, config: SfmConfig,
             times: StageTimes) -> tuple[dict[int, pycolmap.Reconstruction], int]:
-    """COLMAP's models by index, and the number of pairs matched in full."""
+    """COLMAP's models by index, and the number of pairs matched in full. With preemptive
+    matching, photos the largest model leaves out get a second chance: each is matched with
+    every other photo and the mapping runs again (:class:`PreemptiveMatching`)."""
     import pycolmap
 
     database = work_dir / "database.db"
     with times.stage(FEATURES):
         extract_features(photos, upright_dir, database, config)
+    names = sorted(p.name for p in photos)
     with times.stage(MATCHING):
         if isinstance(config.matching, PreemptiveMatching):
-            pairs = preemptive_pairs(database, config.matching)
-            pairs_path = work_dir / "pairs.txt"
-            pairs_path.write_text("".join(f"{a} {b}\n" for a, b in pairs))
-            pycolmap.match_image_pairs(
-                database, pairing_options=pycolmap.ImportedPairingOptions(
-                    match_list_path=pairs_path), device=pycolmap.Device.cpu)
-            matched = len(pairs)
+            pairs = set(preemptive_pairs(database, config.matching))
+            _match_pairs(database, work_dir / "pairs.txt", sorted(pairs))
         else:
             pycolmap.match_exhaustive(database, device=pycolmap.Device.cpu)
-            matched = len(photos) * (len(photos) - 1) // 2
+            pairs = {(a, b) for i, a in enumerate(names) for b in names[i + 1:]}
+    with times.stage(MAPPING):
+        models = _mapping(database, upright_dir, work_dir / "sparse", config)
+    left_out = set(names) - _largest_model_names(models)
+    if not left_out or not isinstance(config.matching, PreemptiveMatching):
+        return models, len(pairs)
+    more = sorted({(min(a, b), max(a, b)) for a in left_out for b in names if a != b} - pairs)
+    with times.stage(MATCHING):
+        _match_pairs(database, work_dir / "pairs-left-out.txt", more)
+    with times.stage(MAPPING):
+        again = _mapping(database, upright_dir, work_dir / "sparse-again", config)
+    if len(_largest_model_names(again)) > len(set(names) - left_out):
+        models = again
+    return models, len(pairs) + len(more)
+
+
+def _match_pairs(database: Path, pairs_path: Path, pairs: list[tuple[str, str]]) -> None:
+    """Match and verify ``pairs`` of image names in full (the list goes to ``pairs_path``)."""
+    import pycolmap
+
+    pairs_path.write_text("".join(f"{a} {b}\n" for a, b in pairs))
+    pycolmap.match_image_pairs(database, pairing_options=pycolmap.ImportedPairingOptions(
+        match_list_path=pairs_path), device=pycolmap.Device.cpu)
+
+
+def _mapping(database: Path, upright_dir: Path, out_dir: Path,
+             config: SfmConfig) -> dict[int, pycolmap.Reconstruction]:
+    import pycolmap
+
     mapping = pycolmap.IncrementalPipelineOptions()
     mapping.num_threads = config.threads
     mapping.random_seed = config.seed
-    with times.stage(MAPPING):
-        return pycolmap.incremental_mapping(database, upright_dir, work_dir / "sparse",
-                                            mapping), matched
+    return pycolmap.incremental_mapping(database, upright_dir, out_dir, mapping)
+
+
+def _largest_model_names(models: dict[int, pycolmap.Reconstruction]) -> set[str]:
+    best = max(models.values(), key=lambda r: r.num_reg_images(), default=None)
+    return set() if best is None else {best.images[i].name for i in best.reg_image_ids()}
 
 
 def extract_features(photos: Sequence[Photo], upright_dir: Path, database: Path,
