@@ -2,7 +2,7 @@
 truth when the photos are renders; prints a Markdown table.
 
     python bench/photos_12mp.py [--photos DIR] [--work DIR] [--workers N] [--views N]
-        [--max-image-px PX] [--max-features N]
+        [--max-image-px PX] [--max-features N] [--exhaustive]
 
 Without ``--photos`` it renders, once (kept in ``--work``, resumed where it stopped), 100
 orbit views of 4000 x 3000 px of the tiny preset's ``tiny_l_shaped`` in the photo look
@@ -20,9 +20,10 @@ seconds, and in brackets the CPU seconds the process spent in them (threads incl
 which other work on shared cores does not change. ``--views N`` poses N of the 100 views,
 evenly spaced (a quick run). ``--max-image-px`` and ``--max-features`` set the
 structure-from-motion options of :class:`dataset.importers.photos.sfm.SfmConfig` (default:
-its defaults). With ``--photos DIR`` (a folder of photos) it poses those instead, with a
-stand-in ``--known-height`` of 10 m (the scale does not change the time), and reports no
-pose error.
+its defaults); ``--exhaustive`` matches every pair instead of the pairs preemptive matching
+keeps (the default; the table's "pairs matched"). With ``--photos DIR`` (a folder of
+photos) it poses those instead, with a stand-in ``--known-height`` of 10 m (the scale does
+not change the time), and reports no pose error.
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ from dataset.generate import scene_seed  # noqa: E402
 from dataset.importers.photos.metric_frame import ScaleHint  # noqa: E402
 from dataset.importers.photos.photo_folder import list_photos  # noqa: E402
 from dataset.importers.photos.pose_error import pose_errors  # noqa: E402
+from dataset.importers.photos.preemptive_pairs import ExhaustiveMatching  # noqa: E402
 from dataset.importers.photos.sfm import SfmConfig  # noqa: E402
 from dataset.importers.photos.source import RECORD_KEY, PhotosOptions, read_photos  # noqa: E402
 from dataset.importers.photos.stage_times import (  # noqa: E402
@@ -83,7 +85,7 @@ STRIP_ROWS = 375
 time in the kernel; strips of 375 rows give the same pixels (the shading is per ray)."""
 HEIGHT_STAND_IN_M = 10.0
 """``--photos``' scale: any scale poses the photos in the same time."""
-COLUMNS = ("photos", "pixels", "posed", *(s.label for s in STAGES), "total s",
+COLUMNS = ("photos", "pixels", "posed", "pairs matched", *(s.label for s in STAGES), "total s",
            "rotation deg (median / max)", "position m (median / max)", "scale error %")
 
 
@@ -157,6 +159,7 @@ def table_row(photos_dir: Path, scene_dir: Path, record: dict,
     wall, cpu = record[SECONDS_KEY], record[CPU_SECONDS_KEY]
     posed = record["posed"]
     row = [str(len(photos)), pixels, f"{posed} ({100 * posed / len(photos):.0f} %)",
+           f"{record['matched_pairs']} of {record['all_pairs']}",
            *(f"{wall.get(key, 0.0):.0f} ({cpu.get(key, 0.0):.0f})"
              for key in [s.key for s in STAGES] + [TOTAL_KEY])]
     if truth is None:
@@ -213,10 +216,13 @@ def main(argv: list[str] | None = None) -> int:
                    help=f"SfmConfig.max_image_px (default {defaults.max_image_px})")
     p.add_argument("--max-features", type=int, default=defaults.max_features,
                    help=f"SfmConfig.max_features (default {defaults.max_features})")
+    p.add_argument("--exhaustive", action="store_true", help="match every pair (default: "
+                   "preemptive matching, SfmConfig.matching)")
     args = p.parse_args(argv)
     if not 3 <= args.views <= PHOTOS:
         p.error(f"--views must be 3 to {PHOTOS}")
-    sfm = replace(defaults, max_image_px=args.max_image_px, max_features=args.max_features)
+    sfm = replace(defaults, max_image_px=args.max_image_px, max_features=args.max_features,
+                  **({"matching": ExhaustiveMatching()} if args.exhaustive else {}))
     if args.photos is None:
         photos_dir, truth = stripped_capture(args.work, args.workers, args.views)
         scale = ScaleHint(known_distance=known_pair(truth))

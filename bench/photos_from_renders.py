@@ -2,7 +2,7 @@
 
     python bench/photos_from_renders.py [--preset P --building B ...] [--views N]
         [--resolution PX] [--look photo|plain] [--paths orbit street] [--context]
-        [--work DIR]
+        [--work DIR] [--shuffle SEED] [--exhaustive]
 
 Renders each building (``--preset``/``--building`` pairs in order; default the tiny preset's
 ``tiny_l_shaped``) with ``--views`` orbit views and, with ``--paths ... street``, its street
@@ -15,6 +15,10 @@ and compares the recovered cameras with the true ones after the best similarity:
 views posed, rotation error (deg), camera position error (m), scale error (%), the up axis's
 tilt (deg).
 Orbit (train + eval frames) and street frames are posed separately (different lenses).
+``--shuffle SEED`` names the photos ``IMG_<n>.jpg`` in a random order drawn from the seed (a
+user's unordered folder; :func:`~dataset.importers.photos.stripped_renders.strip_renders`);
+``--exhaustive`` matches every pair of photos instead of the pairs preemptive matching keeps
+(:class:`~dataset.importers.photos.sfm.SfmConfig`'s default).
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from bench.tables import markdown_table  # noqa: E402
 from dataset.generate import generate_preset  # noqa: E402
+from dataset.importers.photos.preemptive_pairs import ExhaustiveMatching  # noqa: E402
 from dataset.importers.photos.sfm import SfmConfig  # noqa: E402
 from dataset.importers.photos.stripped_renders import pose_stripped_renders  # noqa: E402
 from dataset.rendering.shading import RgbConfig  # noqa: E402
@@ -43,9 +48,10 @@ COLUMNS = ("building", "path", "context", "look", "views", "posed", "rotation de
 
 
 def run_row(scene_dir: Path, work: Path, path: str, context: bool, look: str,
-            sfm: SfmConfig) -> list[str]:
+            sfm: SfmConfig, shuffle_seed: int | None = None) -> list[str]:
     splits = (STREET_SPLIT,) if path == "street" else (TRAIN_PROTOCOL, EVAL_SPLIT)
-    run = pose_stripped_renders(scene_dir, work / f"{scene_dir.name}-{path}", splits, sfm=sfm)
+    run = pose_stripped_renders(scene_dir, work / f"{scene_dir.name}-{path}", splits, sfm=sfm,
+                                shuffle_seed=shuffle_seed)
     head = [scene_dir.name, path, "yes" if context else "no", look, str(run.views),
             f"{run.posed} ({100 * run.posed_fraction:.0f} %)"]
     e = run.errors
@@ -69,6 +75,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--context", action="store_true", help="render the neighbours too")
     p.add_argument("--work", type=Path, help="keep renders and models here (default: a "
                    "temporary folder)")
+    p.add_argument("--shuffle", type=int, metavar="SEED", help="name the photos in a random "
+                   "order drawn from SEED (default: by frame)")
+    p.add_argument("--exhaustive", action="store_true", help="match every pair (default: "
+                   "preemptive matching)")
     args = p.parse_args(argv)
     presets, buildings = args.preset or ["tiny"], args.building or ["tiny_l_shaped"]
     if len(presets) != len(buildings):
@@ -77,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
                             multi=False, context=args.context,
                             street=StreetConfig() if "street" in args.paths else None,
                             rgb=RgbConfig(look=args.look))
-    sfm = SfmConfig()
+    sfm = SfmConfig(matching=ExhaustiveMatching()) if args.exhaustive else SfmConfig()
     rows = []
     with tempfile.TemporaryDirectory(prefix="photos-from-renders-") as tmp:
         work = args.work or Path(tmp)
@@ -88,7 +98,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{building}: rendered in {time.perf_counter() - start:.0f} s",
                   file=sys.stderr)
             for path in args.paths:
-                rows.append(run_row(scene_dir, work, path, args.context, args.look, sfm))
+                rows.append(run_row(scene_dir, work, path, args.context, args.look, sfm,
+                                    args.shuffle))
     print(markdown_table(f"Photos source on stripped renders ({args.resolution} px)",
                          COLUMNS, rows))
     return 0

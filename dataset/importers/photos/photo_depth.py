@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import math
 from collections import Counter
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,7 @@ import numpy as np
 from dataset.importers.photos.metric_frame import Similarity
 from dataset.importers.photos.posed import PosedPhoto
 from dataset.importers.photos.sparse_depth import SparseDepthConfig, piecewise_planar_depth_z_m
-from envelope.scene_record import DEFAULT_DEPTH_UNIT_M, Scene
+from envelope.scene_record import DEFAULT_DEPTH_UNIT_M, Frame, Scene
 from envelope.scenes.images import write_depth_m
 
 DEPTH_FOLDER = "depth"
@@ -33,12 +35,15 @@ MAX_UNITS = 65535  # a 16-bit PNG's largest value
 
 
 def with_photo_depths(scene: Scene, photos: tuple[PosedPhoto, ...], similarity: Similarity,
-                      record_key: str, config: SparseDepthConfig | None = None) -> Scene:
+                      record_key: str, config: SparseDepthConfig | None = None,
+                      threads: int = 1) -> Scene:
     """Write the depth image of each of ``scene``'s frames (``photos`` in the same order,
     their points taken to the scene's frame by ``similarity``) under ``scene.root``; return
     the scene with their ``depth_file_path``, its depth unit, and a ``depth`` entry in its
     ``extra[record_key]`` record (how depth was made, how many photos have it, the median
-    points per photo and share of pixels with depth). ``config``: ``None`` for the default.
+    points per photo and share of pixels with depth). ``config``: ``None`` for the default;
+    ``threads``: photos worked on at once (triangulating, filling and encoding a depth image
+    leave Python's lock for much of their time).
 
     Raises
     ------
@@ -59,19 +64,14 @@ def with_photo_depths(scene: Scene, photos: tuple[PosedPhoto, ...], similarity: 
     unit_m = depth_unit_m(max((_farthest_m(pts, f.world_from_camera)
                                for f, pts in zip(scene.frames, points) if pts is not None),
                               default=0.0))
-    frames, counts, shares = [], [], []
-    for frame, pts in zip(scene.frames, points):
-        if pts is None or len(pts) < 3:
-            frames.append(frame)
-            continue
-        depth = piecewise_planar_depth_z_m(pts, frame.intrinsics, frame.world_from_camera,
-                                           config)
-        relative = f"{DEPTH_FOLDER}/{Path(frame.file_path).stem}.png"
+    if with_points:
         (scene.root / DEPTH_FOLDER).mkdir(exist_ok=True)
-        write_depth_m(scene.root / relative, depth, unit_m)
-        frames.append(replace(frame, depth_file_path=relative))
-        counts.append(len(pts))
-        shares.append(float(np.mean(depth > 0)))
+    with ThreadPoolExecutor(max(1, threads)) as pool:
+        done = list(pool.map(partial(_with_depth, scene.root, unit_m, config),
+                             scene.frames, points))
+    frames = [frame for frame, _, _ in done]
+    counts = [count for _, count, _ in done if count]
+    shares = [share for _, count, share in done if count]
     record = {"source": DEPTH_SOURCE, "photos_with_depth": len(counts),
               "max_incidence_deg": config.max_incidence_deg}
     if counts:
@@ -80,6 +80,21 @@ def with_photo_depths(scene: Scene, photos: tuple[PosedPhoto, ...], similarity: 
     extra = {**scene.extra, record_key: {**scene.extra.get(record_key, {}),
                                          DEPTH_RECORD_KEY: record}}
     return replace(scene, frames=tuple(frames), depth_unit_scale_factor=unit_m, extra=extra)
+
+
+def _with_depth(root: Path, unit_m: float, config: SparseDepthConfig, frame: Frame,
+                points_m: np.ndarray | None) -> tuple[Frame, int, float]:
+    """``frame`` with its depth image written under ``root`` (``points_m``: (N, 3) the
+    points it observes, scene frame), the number of points and the share of pixels with
+    depth; the frame unchanged, 0 and 0.0 when it has fewer than 3 points."""
+    if points_m is None or len(points_m) < 3:
+        return frame, 0, 0.0
+    depth = piecewise_planar_depth_z_m(points_m, frame.intrinsics, frame.world_from_camera,
+                                       config)
+    relative = f"{DEPTH_FOLDER}/{Path(frame.file_path).stem}.png"
+    write_depth_m(root / relative, depth, unit_m)
+    return (replace(frame, depth_file_path=relative), len(points_m),
+            float(np.mean(depth > 0)))
 
 
 def depth_unit_m(max_depth_m: float) -> float:

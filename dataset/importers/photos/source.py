@@ -52,6 +52,7 @@ from dataset.importers.photos.posed import (
     sparse_points,
     undistorted_rgb,
 )
+from dataset.importers.photos.preemptive_pairs import ExhaustiveMatching, PreemptiveMatching
 from dataset.importers.photos.sfm import SfmConfig, reconstruct
 from dataset.importers.photos.stage_times import (
     DEPTH,
@@ -143,17 +144,11 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
     with tempfile.TemporaryDirectory(prefix="photos-sfm-") as work:
         upright = Path(work) / "upright"
         upright.mkdir()
-        with times.stage(READING):
-            for photo in photos:
-                # Every photo is decoded here, before COLMAP sees it: a broken file stops the
-                # run.
-                rgb = read_photo_rgb(photo.path)
-                if _read_alike_by_colmap(photo.path):
-                    shutil.copyfile(photo.path, upright / photo.name)  # no encoding: faster
-                else:
-                    Image.fromarray(rgb).save(upright / photo.name, format="PNG",
-                                              compress_level=1)
-        model = reconstruct(photos, upright, Path(work), config, times)
+        with times.stage(READING), ThreadPoolExecutor(_threads(config)) as pool:
+            # Threads: decoding a photo leaves Python's lock.
+            list(pool.map(partial(_upright_copy, upright), photos))
+        built = reconstruct(photos, upright, Path(work), config, times)
+        model = built.model
         posed = from_reconstruction(model, upright, upright=True)
         # The upright copies go with the temporary folder: point back at the photos.
         posed = tuple(replace(p, path=path / p.name) for p in posed)
@@ -161,11 +156,37 @@ def _structure_from_motion(photos: tuple[Photo, ...], config: SfmConfig,
         return PosedPhotos(posed, sparse_points(model),
                            tuple(p.name for p in photos if p.name not in placed),
                            {"input": "photos", "structure_from_motion": "COLMAP (pycolmap) "
-                            "incremental mapping, SIFT, exhaustive matching, CPU",
+                            "incremental mapping, SIFT, CPU",
+                            "matching": _matching_label(config.matching),
+                            "matched_pairs": built.matched_pairs,
+                            "all_pairs": built.all_pairs,
                             "sift_max_image_px": config.max_image_px,
                             "sift_max_features": config.max_features,
                             "mean_reprojection_error_px":
                                 round(float(model.compute_mean_reprojection_error()), 4)})
+
+
+def _upright_copy(upright: Path, photo: Photo) -> None:
+    """Decode ``photo`` (a broken file stops the run here, before COLMAP sees it) and put an
+    upright copy of it into ``upright`` under its name."""
+    rgb = read_photo_rgb(photo.path)
+    if _read_alike_by_colmap(photo.path):
+        shutil.copyfile(photo.path, upright / photo.name)  # no encoding: faster
+    else:
+        Image.fromarray(rgb).save(upright / photo.name, format="PNG", compress_level=1)
+
+
+def _threads(config: SfmConfig) -> int:
+    """The threads ``config`` asks for (-1: one per CPU core)."""
+    return (os.cpu_count() or 1) if config.threads == -1 else config.threads
+
+
+def _matching_label(matching: PreemptiveMatching | ExhaustiveMatching) -> str:
+    if isinstance(matching, ExhaustiveMatching):
+        return "exhaustive (every pair)"
+    return (f"preemptive: pairs with >= {matching.min_matches} matches of their "
+            f"{matching.top_features} largest features, and each photo's "
+            f"{matching.min_partners} best")
 
 
 def _read_alike_by_colmap(path: Path) -> bool:
@@ -192,7 +213,7 @@ def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
             options.scale, tuple(read_gps_fix(p.path) for p in posed.photos)
             if options.scale.gps else None, city)
     (out_dir / "images").mkdir()
-    threads = (os.cpu_count() or 1) if options.sfm.threads == -1 else options.sfm.threads
+    threads = _threads(options.sfm)
     with times.stage(WRITING), ThreadPoolExecutor(threads) as pool:
         # Threads: decoding, undistorting and encoding a photo leave Python's lock.
         frames = list(tqdm(pool.map(partial(_write_photo, out_dir, similarity), posed.photos),
@@ -202,7 +223,7 @@ def _write(read: Callable[[Path, StageTimes], PosedPhotos], path: Path,
               "unposed": list(posed.unposed), "scale_factor": similarity.scale}
     scene = Scene(out_dir, tuple(frames), extra={RECORD_KEY: record})
     with times.stage(DEPTH):
-        scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY)
+        scene = with_photo_depths(scene, posed.photos, similarity, RECORD_KEY, threads=threads)
     scene = replace(scene, extra={**scene.extra, RECORD_KEY: {**scene.extra[RECORD_KEY],
                                                               **times.record()}})
     if options.progress:

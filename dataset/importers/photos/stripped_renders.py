@@ -56,11 +56,13 @@ class StrippedRun:
         return self.posed / self.views
 
 
-def strip_renders(scene_dir: str | Path, photos_dir: str | Path,
-                  splits: Sequence[str]) -> dict[str, np.ndarray]:
+def strip_renders(scene_dir: str | Path, photos_dir: str | Path, splits: Sequence[str],
+                  shuffle_seed: int | None = None) -> dict[str, np.ndarray]:
     """Copy the RGB images of ``splits`` of the scene at ``scene_dir`` into ``photos_dir``
     (created) as JPEG photos named ``<frame stem>.jpg`` with camera EXIF; return each photo's
-    true (4, 4) world_from_camera pose by photo name.
+    true (4, 4) world_from_camera pose by photo name. With ``shuffle_seed`` the photos are
+    named ``IMG_<n>.jpg`` instead, n a random permutation of 0 .. count - 1 drawn from the
+    seed: a user's folder, whose names and order say nothing of where each was taken.
 
     Raises
     ------
@@ -71,9 +73,11 @@ def strip_renders(scene_dir: str | Path, photos_dir: str | Path,
     frames = _frames(scene, splits)
     photos_dir = Path(photos_dir)
     photos_dir.mkdir(parents=True)
+    names = ([_photo_name(f) for f in frames] if shuffle_seed is None else
+             [f"IMG_{n:04d}.jpg"
+              for n in np.random.default_rng(shuffle_seed).permutation(len(frames))])
     truth = {}
-    for frame in frames:
-        name = _photo_name(frame)
+    for frame, name in zip(frames, names):
         k = frame.intrinsics
         exif = Image.Exif()
         exif[ExifTags.Base.Make], exif[ExifTags.Base.Model] = CAMERA_MAKE, CAMERA_MODEL
@@ -121,15 +125,17 @@ def known_pair(truth: dict[str, np.ndarray]) -> KnownDistance:
 
 
 def pose_stripped_renders(scene_dir: str | Path, work_dir: str | Path, splits: Sequence[str],
-                          *, sfm: SfmConfig | None = None) -> StrippedRun:
-    """Strip the renders of ``splits`` into ``work_dir / <scene name>``, pose them with the
-    photos source (``sfm``: its structure-from-motion settings, default
+                          *, sfm: SfmConfig | None = None,
+                          shuffle_seed: int | None = None) -> StrippedRun:
+    """Strip the renders of ``splits`` into ``work_dir / <scene name>`` (``shuffle_seed``:
+    under shuffled names, :func:`strip_renders`), pose them with the photos source (``sfm``:
+    its structure-from-motion settings, default
     :class:`~dataset.importers.photos.sfm.SfmConfig`; scene written to
     ``work_dir / "posed"``) and compare with the truth."""
     sfm = SfmConfig() if sfm is None else sfm
     scene_dir, work_dir = Path(scene_dir), Path(work_dir)
     photos_dir = work_dir / scene_dir.name
-    truth = strip_renders(scene_dir, photos_dir, splits)
+    truth = strip_renders(scene_dir, photos_dir, splits, shuffle_seed)
     known = known_pair(truth)
     options = PhotosOptions(scale=ScaleHint(known_distance=known), sfm=sfm, progress=False)
     start = time.perf_counter()

@@ -42,3 +42,17 @@ def test_photo_look_renders_are_posed_from_the_images_alone(tmp_path):
     assert run.errors.scale_error < SCALE_TOLERANCE
     assert np.median(run.errors.rotation_deg) < ROTATION_TOLERANCE_DEG
     assert np.median(run.errors.position_m) < POSITION_TOLERANCE_M
+
+
+@pytest.mark.slow
+def test_shuffled_and_renamed_photos_are_posed_as_well(tmp_path):
+    """A user's folder: the same capture under names in random order (IMG_<n>.jpg), so
+    neither the names nor COLMAP's image order say where a photo was taken; the pairs
+    preemptive matching keeps (the default) depend on the features alone."""
+    scene, = generate_preset("tiny", tmp_path / "scenes", CONFIG, buildings=["tiny_l_shaped"],
+                             progress=False)
+    run = pose_stripped_renders(scene, tmp_path / "work", ("train", "eval"), shuffle_seed=7)
+    assert run.failure == ""
+    assert run.posed_fraction >= MIN_POSED_FRACTION, run.posed
+    assert run.errors.scale_error < SCALE_TOLERANCE
+    assert np.median(run.errors.rotation_deg) < ROTATION_TOLERANCE_DEG
