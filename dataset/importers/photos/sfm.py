@@ -27,6 +27,7 @@ from dataset.importers.photos.preemptive_pairs import (
     PreemptiveMatching,
     keypoint_scales_px,
     largest_scale_descriptors,
+    matches_every_pair,
     preliminary_match_counts,
     selected_pairs,
 )
@@ -111,15 +112,17 @@ def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path, config: 
             times: StageTimes) -> tuple[dict[int, pycolmap.Reconstruction], int]:
     """COLMAP's models by index, and the number of pairs matched in full. With preemptive
     matching, photos the largest model leaves out get a second chance: each is matched with
-    every other photo and the mapping runs again (:class:`PreemptiveMatching`)."""
+    every other photo and the mapping runs again (:class:`PreemptiveMatching`); a set small
+    enough is matched in every pair (:func:`matches_every_pair`)."""
     import pycolmap
 
     database = work_dir / "database.db"
     with times.stage(FEATURES):
         extract_features(photos, upright_dir, database, config)
     names = sorted(p.name for p in photos)
+    preemptive = not matches_every_pair(config.matching, len(photos))
     with times.stage(MATCHING):
-        if isinstance(config.matching, PreemptiveMatching):
+        if preemptive:
             pairs = set(preemptive_pairs(database, config.matching))
             _match_pairs(database, work_dir / "pairs.txt", sorted(pairs))
         else:
@@ -128,7 +131,7 @@ def _models(photos: Sequence[Photo], upright_dir: Path, work_dir: Path, config: 
     with times.stage(MAPPING):
         models = _mapping(database, upright_dir, work_dir / "sparse", config)
     left_out = set(names) - _largest_model_names(models)
-    if not left_out or not isinstance(config.matching, PreemptiveMatching):
+    if not left_out or not preemptive:
         return models, len(pairs)
     more = sorted({(min(a, b), max(a, b)) for a in left_out for b in names if a != b} - pairs)
     with times.stage(MATCHING):

@@ -186,7 +186,8 @@ def _matching_label(matching: PreemptiveMatching | ExhaustiveMatching) -> str:
         return "exhaustive (every pair)"
     return (f"preemptive: pairs with >= {matching.min_matches} matches of their "
             f"{matching.top_features} largest features, and each photo's "
-            f"{matching.min_partners} best")
+            f"{matching.min_partners} best; every pair up to {matching.every_pair_up_to} "
+            f"photos")
 
 
 def _read_alike_by_colmap(path: Path) -> bool:

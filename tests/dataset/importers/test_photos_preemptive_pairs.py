@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from dataset.importers.photos.preemptive_pairs import (
+    ExhaustiveMatching,
     PreemptiveMatching,
+    matches_every_pair,
     keypoint_scales_px,
     largest_scale_descriptors,
     preliminary_match_counts,
@@ -108,3 +110,13 @@ def test_bad_settings_and_shapes_are_refused():
         selected_pairs(np.triu(np.ones((3, 3), np.int64), 1), 1, 1)
     with pytest.raises(ValueError, match=r"\(N, 4\) or \(N, 6\)"):
         keypoint_scales_px(np.zeros((3, 5)))
+    with pytest.raises(ValueError, match="every_pair_up_to"):
+        PreemptiveMatching(every_pair_up_to=-1)
+
+
+def test_small_sets_are_matched_in_every_pair():
+    # 30 photos (435 pairs) or fewer: every pair; above, the preemptive pairs.
+    assert matches_every_pair(PreemptiveMatching(), 30)
+    assert not matches_every_pair(PreemptiveMatching(), 31)
+    assert not matches_every_pair(PreemptiveMatching(every_pair_up_to=0), 3)
+    assert matches_every_pair(ExhaustiveMatching(), 1000)
