@@ -10,9 +10,9 @@ import pytest
 from dataset.importers.photos.preemptive_pairs import (
     ExhaustiveMatching,
     PreemptiveMatching,
-    matches_every_pair,
     keypoint_scales_px,
     largest_scale_descriptors,
+    matches_every_pair,
     preliminary_match_counts,
     selected_pairs,
 )
