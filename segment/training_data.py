@@ -125,7 +125,7 @@ def sample_batch(scenes: Sequence[Any], batch: int, config: AugmentConfig,
 @dataclass(frozen=True)
 class PreloadedSource:
     """The frames of a training scene or real-photo source, read once and kept in memory
-    at a network's working scale: ``frames`` are indices into ``rgbs`` and ``labels_``;
+    at a network's working scale: ``frames`` are indices into ``rgbs`` and ``label_maps``;
     ``name`` and ``record`` are the source's."""
 
     name: str
@@ -152,10 +152,8 @@ def preload(sources: Sequence[Any], long_side_px: int | None, frames_per_source:
     out = []
     for source in tqdm(sources, desc="read training frames", unit="source",
                        disable=not progress):
-        picked = (evenly_spaced(source.frames, frames_per_source) if frames_per_source
-                  else source.frames)
         rgbs, label_maps = [], []
-        for frame in picked:
+        for frame in evenly_spaced(source.frames, frames_per_source or None):
             rgb, labels = source.rgb_and_labels(frame)
             rgbs.append(scale_to_long_side(rgb, long_side_px))
             label_maps.append(scale_to_long_side(labels, long_side_px, labels=True))

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from envelope.mesh import triangle_areas_m2, triangle_normals
+
 SAMPLE_SPACING_M = 0.5
 """The model's surfaces are sampled about this far apart (metres)."""
 TRIMS_M = (4.0, 2.0, 1.0, 0.5)
@@ -99,14 +101,13 @@ def surface_samples(triangles_m: np.ndarray, own_triangles: int,
         No triangle with an area.
     """
     tri = np.asarray(triangles_m, dtype=np.float64)
-    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    area = 0.5 * np.linalg.norm(cross, axis=1)
+    area = triangle_areas_m2(tri)
     keep = area > 1e-9
     if not keep.any():
         raise ValueError("the city model has no surface with an area to fit the photos to")
     own = np.arange(len(tri)) < own_triangles
-    tri, cross, area, own = tri[keep], cross[keep], area[keep], own[keep]
-    normals = cross / (2.0 * area[:, None])
+    tri, area, own = tri[keep], area[keep], own[keep]
+    normals = triangle_normals(tri)
     count = np.maximum(1, np.ceil(area / spacing_m ** 2).astype(np.int64))
     owner = np.repeat(np.arange(len(tri)), count)
     rng = np.random.default_rng(SAMPLE_SEED)
