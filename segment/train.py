@@ -200,10 +200,10 @@ def _optimise(model: UNet, train: tuple[list[Source], list[Source]],
                      "minutes": (time.perf_counter() - start) / 60}
             losses = []
             if val[0] and val[1]:
-                render_iou = _validate(model, val[0], config.val_frames, config.threads)
+                render_iou = validation_iou(model, val[0], config.val_frames, config.threads)
                 entry["val_renders_window_iou"] = float(render_iou[SemanticClass.WINDOW])
             if selection:
-                iou = _validate(model, selection, config.val_frames, config.threads)
+                iou = validation_iou(model, selection, config.val_frames, config.threads)
                 entry["val_window_iou"] = float(iou[SemanticClass.WINDOW])
                 entry["val_score"] = float(np.mean(iou[list(SELECTION_CLASSES)]))
                 if entry["val_score"] > best.score:
@@ -232,7 +232,7 @@ def _mixed_batch(renders: list[Source], real: list[Source], n_renders: int,
     return x, torch.cat([p[1] for p in parts])
 
 
-def _validate(model: UNet, val: Sequence[TrainingScene | RealSource], frames: int,
+def validation_iou(model: UNet, val: Sequence[Source], frames: int,
               threads: int) -> np.ndarray:
     """(NUM_CLASSES,) IoU per class on the validation scenes (or real sources), pooled per
     scene, then the mean over scenes (NaN-aware). A render scene gives ``frames`` evenly
