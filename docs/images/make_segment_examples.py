@@ -12,9 +12,9 @@ Three rows, each an image and what is known of it, then each weights' masks:
 Columns: the image, its exact labels (a blank panel for the photo), the render weights'
 masks (``renders``, the default), the photo weights' masks (``photos``). Views are chosen
 by a rule on the exact labels, not by looking at the masks. The two scenes are rendered
-into ``--scratch`` (kept there, so a rerun reuses them; default a temporary folder), about
-two minutes on 2 cores. Writes ``docs/images/segment_examples.png`` and prints the share of each image that each
-set of masks calls window.
+into ``--scratch`` (kept there, so a rerun reuses them; default a temporary folder), a few
+minutes on 2 cores. Writes ``docs/images/segment_examples.png`` and prints the share of
+each image that each set of masks calls window.
 """
 
 from __future__ import annotations
