@@ -33,15 +33,15 @@ sys.path.insert(0, str(ROOT))
 from dataset.generate import generate_preset  # noqa: E402
 from dataset.rendering.street_views import StreetConfig  # noqa: E402
 from dataset.scenes.scene_writer import GenerateConfig  # noqa: E402
-from envelope.classes import CLASS_RGB, SemanticClass  # noqa: E402
+from envelope.classes import SemanticClass  # noqa: E402
 from envelope.photo_io import read_photo_rgb  # noqa: E402
+from figures.style import colour_labels  # noqa: E402
 from segment.segmenter import resolve_segmenter, segment_rgb  # noqa: E402
 
 PHOTO = ROOT / "tests" / "fixtures" / "photo_building" / "palace-of-culture-400px.jpg"
 OUT = Path(__file__).resolve().parent / "segment_examples.png"
 PANEL_HEIGHT_PX = 256
 WEIGHTS = ("renders", "photos")
-PALETTE = np.array(CLASS_RGB, dtype=np.uint8)  # (NUM_CLASSES, 3)
 
 
 def most_windows_frame(scene: Path, prefix: str) -> str:
@@ -73,13 +73,13 @@ def example_row(name: str, rgb: np.ndarray, labels: np.ndarray | None,
                 segmenters: list) -> np.ndarray:
     """(PANEL_HEIGHT_PX, 4 panels wide, 3) uint8: image | exact labels | each weights' masks.
     Prints the share of the image each set of masks calls window."""
-    exact = PALETTE[labels] if labels is not None else np.full_like(rgb, 255)
+    exact = colour_labels(labels) if labels is not None else np.full_like(rgb, 255)
     masks = [segment_rgb(s, rgb) for s in segmenters]
     shares = [("exact", labels)] if labels is not None else []
     shares += [(s.name, m) for s, m in zip(segmenters, masks, strict=True)]
     print(f"{name}: window share of the image " + ", ".join(
         f"{n} {(m == SemanticClass.WINDOW).mean():.3f}" for n, m in shares))
-    predicted = [PALETTE[m] for m in masks]
+    predicted = [colour_labels(m) for m in masks]
     gap = np.full((PANEL_HEIGHT_PX, 6, 3), 255, np.uint8)
     panels = [fit_height(p) for p in (rgb, exact, *predicted)]
     return np.concatenate([x for p in panels for x in (p, gap)][:-1], axis=1)
